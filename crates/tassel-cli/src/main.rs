@@ -1,0 +1,2 @@
+//! The `tassel` command.
+fn main() {}

@@ -1,0 +1,282 @@
+//! Compiling rig settings against a skeleton into flat, structure-of-arrays point data.
+
+use super::settings::ChainSettings;
+use crate::collide::Shape;
+use crate::dynamics::RigSettings;
+use crate::error::{Error, Result};
+use crate::math::Transform;
+use crate::pose::Pose;
+use crate::skeleton::Skeleton;
+use std::ops::Range;
+
+/// Marks "no point" in point-index arrays.
+pub(crate) const NONE: u32 = u32::MAX;
+/// Marks a virtual (dummy tip) point that has no joint.
+pub(crate) const VIRTUAL: u16 = u16::MAX;
+
+/// What one simulated point is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct PointInfo {
+    /// The joint it moves, or `None` for a virtual tip.
+    pub joint: Option<usize>,
+    /// Index of its parent point, or `None` for a chain root (animated, not simulated).
+    pub parent: Option<usize>,
+    /// The chain it belongs to.
+    pub chain: usize,
+}
+
+#[derive(Debug, Clone)]
+pub(crate) struct CompiledChain {
+    pub settings: ChainSettings,
+    pub points: Range<usize>,
+    pub colliders: Vec<usize>,
+}
+
+#[derive(Debug, Clone)]
+pub(crate) struct CompiledCollider {
+    pub bone: usize,
+    pub offset: Transform,
+    pub shape: Shape,
+}
+
+/// Chains and colliders compiled against one skeleton. Immutable; share it between every
+/// character that uses the same skeleton and rig.
+#[derive(Debug, Clone)]
+pub struct ChainRig {
+    pub(crate) chains: Vec<CompiledChain>,
+    pub(crate) colliders: Vec<CompiledCollider>,
+    // Per point (structure of arrays), chains one after another, parents before children.
+    pub(crate) joint: Vec<u16>,
+    pub(crate) parent: Vec<u32>,
+    pub(crate) dummy_length: Vec<f32>,
+    pub(crate) damping: Vec<f32>,
+    pub(crate) stiffness: Vec<f32>,
+    pub(crate) radius: Vec<f32>,
+    pub(crate) wd_location: Vec<f32>,
+    pub(crate) wd_rotation: Vec<f32>,
+    pub(crate) limit_angle: Vec<f32>,
+    // Write-back: joints that turn toward their simulated children, in joint order.
+    pub(crate) rotators: Vec<(u16, u32, Range<u32>)>,
+    pub(crate) rotator_children: Vec<u32>,
+    joint_count: usize,
+}
+
+impl ChainRig {
+    /// Compiles `rig` for `skeleton`: resolves bone names, collects each chain's points
+    /// depth-first, evaluates the parameter curves. Errors name the chain or collider.
+    pub fn new(skeleton: &Skeleton, rig: &RigSettings) -> Result<Self> {
+        rig.validate_for(skeleton)?;
+        let rest = Pose::rest(skeleton);
+        let mut out = ChainRig {
+            chains: Vec::new(),
+            colliders: Vec::new(),
+            joint: Vec::new(),
+            parent: Vec::new(),
+            dummy_length: Vec::new(),
+            damping: Vec::new(),
+            stiffness: Vec::new(),
+            radius: Vec::new(),
+            wd_location: Vec::new(),
+            wd_rotation: Vec::new(),
+            limit_angle: Vec::new(),
+            rotators: Vec::new(),
+            rotator_children: Vec::new(),
+            joint_count: skeleton.len(),
+        };
+        for c in &rig.colliders {
+            out.colliders.push(CompiledCollider {
+                bone: skeleton.find(&c.bone).unwrap_or(0),
+                offset: Transform::from_translation_rotation(c.offset, c.rotation.normalize()),
+                shape: c.shape,
+            });
+        }
+        let mut owner: Vec<Option<usize>> = vec![None; skeleton.len()];
+        for (ci, settings) in rig.chains.iter().enumerate() {
+            let root = skeleton.find(&settings.root).unwrap_or(0);
+            let excluded: Vec<usize> = settings
+                .exclude
+                .iter()
+                .filter_map(|e| skeleton.find(e))
+                .collect();
+            let start = out.joint.len();
+            // Depth-first joint order is the skeleton's own order restricted to the subtree.
+            let mut point_of = std::collections::HashMap::new();
+            let mut rest_dist = Vec::new();
+            for j in root..skeleton.len() {
+                if !skeleton.is_descendant_of(j, root) {
+                    if j > root {
+                        // Subtrees are contiguous in depth-first order.
+                        break;
+                    }
+                    continue;
+                }
+                if excluded.iter().any(|&e| skeleton.is_descendant_of(j, e)) {
+                    continue;
+                }
+                if let Some(other) = owner[j] {
+                    return Err(Error::InvalidParameter(format!(
+                        "bone '{}' is in chain '{}' and chain '{}'",
+                        skeleton.name(j),
+                        rig.chains[other].name,
+                        settings.name
+                    )));
+                }
+                owner[j] = Some(ci);
+                let parent = if j == root {
+                    NONE
+                } else {
+                    skeleton
+                        .parent(j)
+                        .and_then(|p| point_of.get(&p).copied())
+                        .unwrap_or(NONE)
+                };
+                let idx = out.joint.len() as u32;
+                point_of.insert(j, idx);
+                out.joint.push(j as u16);
+                out.parent.push(parent);
+                out.dummy_length.push(0.0);
+                let d = if parent == NONE {
+                    0.0
+                } else {
+                    let pj = out.joint[parent as usize] as usize;
+                    rest_dist[parent as usize - start]
+                        + (rest.models[j].translation - rest.models[pj].translation).length()
+                };
+                rest_dist.push(d);
+            }
+            if out.joint.len() - start < 2 && settings.dummy_bone_length <= 0.0 {
+                return Err(Error::InvalidParameter(format!(
+                    "chain '{}': root '{}' has no bone below it to simulate; give it a dummy_bone_length",
+                    settings.name, settings.root
+                )));
+            }
+            // Virtual tips after every leaf.
+            if settings.dummy_bone_length > 0.0 {
+                let real_end = out.joint.len();
+                for p in start..real_end {
+                    let is_leaf = !(start..real_end).any(|c| out.parent[c] == p as u32);
+                    if is_leaf {
+                        out.joint.push(VIRTUAL);
+                        out.parent.push(p as u32);
+                        out.dummy_length.push(settings.dummy_bone_length);
+                        rest_dist.push(rest_dist[p - start] + settings.dummy_bone_length);
+                    }
+                }
+            }
+            let end = out.joint.len();
+            let max_dist = rest_dist.iter().cloned().fold(0.0f32, f32::max).max(1e-6);
+            let curves = &settings.curves;
+            for &d in &rest_dist {
+                let x = d / max_dist;
+                out.damping
+                    .push((settings.damping * curves.damping.eval(x)).clamp(0.0, 1.0));
+                out.stiffness
+                    .push((settings.stiffness * curves.stiffness.eval(x)).clamp(0.0, 1.0));
+                out.radius
+                    .push((settings.radius * curves.radius.eval(x)).max(0.0));
+                out.wd_location.push(
+                    (settings.world_damping_location * curves.world_damping_location.eval(x))
+                        .clamp(0.0, 1.0),
+                );
+                out.wd_rotation.push(
+                    (settings.world_damping_rotation * curves.world_damping_rotation.eval(x))
+                        .clamp(0.0, 1.0),
+                );
+                out.limit_angle.push(
+                    (settings.limit_angle * curves.limit_angle.eval(x))
+                        .clamp(0.0, 180.0)
+                        .to_radians(),
+                );
+            }
+            let colliders = if settings.colliders.is_empty() {
+                (0..rig.colliders.len()).collect()
+            } else {
+                settings
+                    .colliders
+                    .iter()
+                    .filter_map(|n| rig.colliders.iter().position(|c| &c.name == n))
+                    .collect()
+            };
+            out.chains.push(CompiledChain {
+                settings: settings.clone(),
+                points: start..end,
+                colliders,
+            });
+        }
+        // Rotators, in joint order so parents are written before children.
+        let mut rot: Vec<(u16, u32, Vec<u32>)> = Vec::new();
+        for p in 0..out.joint.len() {
+            let parent = out.parent[p];
+            if parent == NONE {
+                continue;
+            }
+            let pj = out.joint[parent as usize];
+            match rot.iter_mut().find(|r| r.1 == parent) {
+                Some(r) => r.2.push(p as u32),
+                None => rot.push((pj, parent, vec![p as u32])),
+            }
+        }
+        rot.sort_by_key(|r| r.0);
+        for (j, p, kids) in rot {
+            let s = out.rotator_children.len() as u32;
+            out.rotator_children.extend(kids);
+            out.rotators
+                .push((j, p, s..out.rotator_children.len() as u32));
+        }
+        Ok(out)
+    }
+
+    /// Number of simulated points (chain roots and virtual tips included).
+    pub fn point_count(&self) -> usize {
+        self.joint.len()
+    }
+
+    /// Number of chains.
+    pub fn chain_count(&self) -> usize {
+        self.chains.len()
+    }
+
+    /// Number of joints of the skeleton this rig was compiled for.
+    pub fn joint_count(&self) -> usize {
+        self.joint_count
+    }
+
+    /// The settings of chain `i`.
+    pub fn chain_settings(&self, i: usize) -> &ChainSettings {
+        &self.chains[i].settings
+    }
+
+    /// The point range of chain `i`.
+    pub fn chain_points(&self, i: usize) -> Range<usize> {
+        self.chains[i].points.clone()
+    }
+
+    /// What point `p` is.
+    pub fn point(&self, p: usize) -> PointInfo {
+        let chain = self
+            .chains
+            .iter()
+            .position(|c| c.points.contains(&p))
+            .unwrap_or(0);
+        PointInfo {
+            joint: (self.joint[p] != VIRTUAL).then_some(self.joint[p] as usize),
+            parent: (self.parent[p] != NONE).then_some(self.parent[p] as usize),
+            chain,
+        }
+    }
+
+    /// The collision radius of point `p`.
+    pub fn point_radius(&self, p: usize) -> f32 {
+        self.radius[p]
+    }
+
+    /// Number of colliders.
+    pub fn collider_count(&self) -> usize {
+        self.colliders.len()
+    }
+
+    /// The colliders chain `i` collides with.
+    pub fn chain_colliders(&self, i: usize) -> &[usize] {
+        &self.chains[i].colliders
+    }
+}

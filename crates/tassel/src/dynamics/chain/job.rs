@@ -1,0 +1,537 @@
+//! Per-character chain state and the frame job.
+
+use super::compile::{ChainRig, NONE, VIRTUAL};
+use super::settings::{PlanarAxis, TimeMode};
+use super::step::{step_chain, StepInput};
+use crate::collide::PlacedCollider;
+use crate::error::{Error, Result};
+use crate::math::{normalize_or, rotation_arc, slerp_shortest, Transform};
+use crate::rng::SplitMix64;
+use crate::skeleton::Skeleton;
+use glam::{Quat, Vec3};
+
+/// The small per-character state of a [`ChainRig`]: point positions and the previous
+/// frame's inputs. Changes only through [`ChainJob::run`], [`ChainState::reset`] and
+/// [`ChainState::teleport`].
+#[derive(Debug, Clone)]
+pub struct ChainState {
+    pos: Vec<Vec3>,
+    prev: Vec<Vec3>,
+    // Deviation from the step's targets after the last and the one-before-last step
+    // (fixed mode interpolates between them).
+    dev: Vec<Vec3>,
+    dev_before: Vec<Vec3>,
+    out: Vec<Vec3>,
+    targets: Vec<Vec3>,
+    prev_targets: Vec<Vec3>,
+    step_targets: Vec<Vec3>,
+    normals: Vec<Vec3>,
+    prev_normals: Vec<Vec3>,
+    step_normals: Vec<Vec3>,
+    colliders: Vec<PlacedCollider>,
+    prev_colliders: Vec<PlacedCollider>,
+    step_colliders: Vec<PlacedCollider>,
+    prev_component: Transform,
+    last_step_component: Vec<Transform>,
+    accumulator: Vec<f32>,
+    dt_old: Vec<f32>,
+    rng: Vec<SplitMix64>,
+    needs_reset: Vec<bool>,
+    teleports: u64,
+}
+
+impl ChainState {
+    /// Fresh state for `rig`; the first frame resets it to the animated pose.
+    pub fn new(rig: &ChainRig) -> Self {
+        let n = rig.point_count();
+        let m = rig.colliders.len();
+        let c = rig.chains.len();
+        let placed = PlacedCollider {
+            shape: crate::collide::Shape::Plane,
+            transform: Transform::IDENTITY,
+        };
+        Self {
+            pos: vec![Vec3::ZERO; n],
+            prev: vec![Vec3::ZERO; n],
+            dev: vec![Vec3::ZERO; n],
+            dev_before: vec![Vec3::ZERO; n],
+            out: vec![Vec3::ZERO; n],
+            targets: vec![Vec3::ZERO; n],
+            prev_targets: vec![Vec3::ZERO; n],
+            step_targets: vec![Vec3::ZERO; n],
+            normals: vec![Vec3::Y; n],
+            prev_normals: vec![Vec3::Y; n],
+            step_normals: vec![Vec3::Y; n],
+            colliders: vec![placed; m],
+            prev_colliders: vec![placed; m],
+            step_colliders: vec![placed; m],
+            prev_component: Transform::IDENTITY,
+            last_step_component: vec![Transform::IDENTITY; c],
+            accumulator: vec![0.0; c],
+            dt_old: vec![0.0; c],
+            rng: rig
+                .chains
+                .iter()
+                .enumerate()
+                .map(|(i, ch)| SplitMix64::new(ch.settings.wind.seed ^ (i as u64) << 32))
+                .collect(),
+            needs_reset: vec![true; c],
+            teleports: 0,
+        }
+    }
+
+    /// Makes the next frame start again from the animated pose (velocities zero).
+    pub fn reset(&mut self) {
+        self.needs_reset.iter_mut().for_each(|r| *r = true);
+    }
+
+    /// Tells the state that the character was moved on purpose: the next frame resets the
+    /// chains instead of swinging them from the old place.
+    pub fn teleport(&mut self) {
+        self.reset();
+    }
+
+    /// The simulated point positions of the last frame's output, model space.
+    pub fn output_positions(&self) -> &[Vec3] {
+        &self.out
+    }
+
+    /// The animated target positions of the last frame, model space.
+    pub fn target_positions(&self) -> &[Vec3] {
+        &self.targets
+    }
+
+    /// Colliders as placed for the last frame, model space.
+    pub fn placed_colliders(&self) -> &[PlacedCollider] {
+        &self.colliders
+    }
+
+    /// How many resets a teleport (or a non-finite result) caused so far.
+    pub fn teleport_count(&self) -> u64 {
+        self.teleports
+    }
+}
+
+/// One frame of every chain of a character.
+///
+/// Reads the animated pose (`locals` and the `models` computed from them) and the
+/// character's world transform; writes simulated rotations back into `locals` and
+/// recomputes `models`.
+#[derive(Debug)]
+pub struct ChainJob<'a> {
+    /// The skeleton the rig was compiled for.
+    pub skeleton: &'a Skeleton,
+    /// The compiled rig.
+    pub rig: &'a ChainRig,
+    /// The character's state.
+    pub state: &'a mut ChainState,
+    /// The character's world transform this frame.
+    pub component: Transform,
+    /// Frame time, seconds (finite, ≥ 0).
+    pub dt: f32,
+    /// In: animated local transforms. Out: with simulated rotations.
+    pub locals: &'a mut [Transform],
+    /// In: animated model transforms. Out: recomputed from the new locals.
+    pub models: &'a mut [Transform],
+}
+
+fn lerp_collider(a: &PlacedCollider, b: &PlacedCollider, w: f32) -> PlacedCollider {
+    PlacedCollider {
+        shape: b.shape,
+        transform: a.transform.lerp(&b.transform, w),
+    }
+}
+
+impl ChainJob<'_> {
+    /// Checks sizes and that the inputs are finite.
+    pub fn validate(&self) -> Result<()> {
+        let n = self.skeleton.len();
+        if self.rig.joint_count() != n {
+            return Err(Error::LengthMismatch {
+                what: "rig joints",
+                expected: n,
+                got: self.rig.joint_count(),
+            });
+        }
+        for (what, got) in [("locals", self.locals.len()), ("models", self.models.len())] {
+            if got != n {
+                return Err(Error::LengthMismatch {
+                    what,
+                    expected: n,
+                    got,
+                });
+            }
+        }
+        if !(self.dt.is_finite() && self.dt >= 0.0) {
+            return Err(Error::InvalidTimeStep(self.dt));
+        }
+        if !self.component.is_finite() {
+            return Err(Error::NonFinite("character transform".into()));
+        }
+        if let Some(i) = self.models.iter().position(|m| !m.is_finite()) {
+            return Err(Error::NonFinite(format!(
+                "animated pose of joint '{}'",
+                self.skeleton.name(i)
+            )));
+        }
+        Ok(())
+    }
+
+    /// Validates, then runs the frame. Never allocates.
+    pub fn run(self) -> Result<()> {
+        self.validate()?;
+        let ChainJob {
+            skeleton,
+            rig,
+            state,
+            component,
+            dt,
+            locals,
+            models,
+        } = self;
+        gather_targets(
+            skeleton,
+            rig,
+            models,
+            &mut state.targets,
+            &mut state.normals,
+            &mut state.colliders,
+        );
+
+        for ci in 0..rig.chains.len() {
+            run_chain(rig, ci, state, &component, dt);
+        }
+        state.prev_targets.copy_from_slice(&state.targets);
+        state.prev_normals.copy_from_slice(&state.normals);
+        state.prev_colliders.copy_from_slice(&state.colliders);
+        state.prev_component = component;
+
+        write_back(skeleton, rig, &state.targets, &state.out, locals, models);
+        crate::pose::LocalToModelJob {
+            skeleton,
+            root: Transform::IDENTITY,
+            locals,
+            models,
+        }
+        .run()
+    }
+}
+
+/// Animated targets, planar normals and placed colliders from the animated model pose.
+fn gather_targets(
+    sk: &Skeleton,
+    rig: &ChainRig,
+    models: &[Transform],
+    targets: &mut [Vec3],
+    normals: &mut [Vec3],
+    colliders: &mut [PlacedCollider],
+) {
+    for p in 0..rig.joint.len() {
+        let j = rig.joint[p];
+        let parent = rig.parent[p];
+        targets[p] = if j == VIRTUAL {
+            let leaf = rig.joint[parent as usize] as usize;
+            let from = sk.parent(leaf).map(|q| models[q].translation);
+            let dir = match from {
+                Some(f) => normalize_or(
+                    models[leaf].translation - f,
+                    models[leaf].rotation * Vec3::Y,
+                ),
+                None => models[leaf].rotation * Vec3::Y,
+            };
+            models[leaf].translation + dir * rig.dummy_length[p]
+        } else {
+            models[j as usize].translation
+        };
+        if parent != NONE {
+            let pj = rig.joint[parent as usize] as usize;
+            let chain = rig.chains.iter().find(|c| c.points.contains(&p));
+            let axis = chain
+                .map(|c| c.settings.planar_constraint)
+                .unwrap_or(PlanarAxis::None);
+            let local_axis = match axis {
+                PlanarAxis::X => Vec3::X,
+                PlanarAxis::Z => Vec3::Z,
+                _ => Vec3::Y,
+            };
+            normals[p] = models[pj].rotation * local_axis;
+        }
+    }
+    for (placed, c) in colliders.iter_mut().zip(&rig.colliders) {
+        let bone = &models[c.bone];
+        let t = Transform::from_translation_rotation(bone.translation, bone.rotation) * c.offset;
+        *placed = PlacedCollider {
+            shape: c.shape,
+            transform: Transform::from_translation_rotation(t.translation, t.rotation),
+        };
+    }
+}
+
+fn reset_chain(rig: &ChainRig, ci: usize, state: &mut ChainState, component: &Transform) {
+    for p in rig.chains[ci].points.clone() {
+        state.pos[p] = state.targets[p];
+        state.prev[p] = state.targets[p];
+        state.dev[p] = Vec3::ZERO;
+        state.dev_before[p] = Vec3::ZERO;
+        state.prev_targets[p] = state.targets[p];
+        state.prev_normals[p] = state.normals[p];
+    }
+    state.prev_colliders.copy_from_slice(&state.colliders);
+    state.accumulator[ci] = 0.0;
+    state.last_step_component[ci] = *component;
+    let s = &rig.chains[ci].settings;
+    let h = 1.0 / s.target_framerate;
+    state.dt_old[ci] = h;
+    // Warm-up: settle in place with the current targets and no character motion.
+    for _ in 0..s.warmup_steps {
+        let input = StepInput {
+            targets: &state.targets,
+            normals: &state.normals,
+            colliders: &state.colliders,
+            move_cs: Vec3::ZERO,
+            rotate_cs: Quat::IDENTITY,
+            gravity_cs: gravity_cs(s, component),
+            wind_cs: wind_cs(s, component),
+            dt: h,
+            dt_old: h,
+            fixed: s.mode == TimeMode::Fixed,
+        };
+        step_chain(
+            rig,
+            ci,
+            &input,
+            &mut state.pos,
+            &mut state.prev,
+            &mut state.rng[ci],
+        );
+    }
+    for p in rig.chains[ci].points.clone() {
+        state.dev[p] = state.pos[p] - state.targets[p];
+        state.dev_before[p] = state.dev[p];
+    }
+    state.needs_reset[ci] = false;
+}
+
+fn gravity_cs(s: &super::ChainSettings, component: &Transform) -> Vec3 {
+    if s.gravity_in_world {
+        component.rotation.inverse() * s.gravity
+    } else {
+        s.gravity
+    }
+}
+
+fn wind_cs(s: &super::ChainSettings, component: &Transform) -> Vec3 {
+    component.rotation.inverse() * normalize_or(s.wind.direction, Vec3::ZERO)
+}
+
+/// Character motion from `a` to `b`, as seen from `b`'s space.
+fn motion_cs(a: &Transform, b: &Transform) -> (Vec3, Quat) {
+    let inv = b.rotation.inverse();
+    (
+        inv * (a.translation - b.translation),
+        (inv * a.rotation).normalize(),
+    )
+}
+
+fn run_chain(rig: &ChainRig, ci: usize, state: &mut ChainState, component: &Transform, dt: f32) {
+    let s = &rig.chains[ci].settings;
+    let points = rig.chains[ci].points.clone();
+    // Teleport detection on the character's own motion this frame.
+    if !state.needs_reset[ci] {
+        let moved = (component.translation - state.prev_component.translation).length();
+        let turned = slerp_angle(state.prev_component.rotation, component.rotation).to_degrees();
+        if (s.teleport_distance > 0.0 && moved > s.teleport_distance)
+            || (s.teleport_rotation > 0.0 && turned > s.teleport_rotation)
+        {
+            state.needs_reset[ci] = true;
+            state.teleports += 1;
+        }
+    }
+    if state.needs_reset[ci] {
+        reset_chain(rig, ci, state, component);
+    } else {
+        match s.mode {
+            TimeMode::Classic => {
+                let dt = dt.min(s.max_delta_time);
+                if dt > 0.0 {
+                    let (move_cs, rotate_cs) = motion_cs(&state.prev_component, component);
+                    let input = StepInput {
+                        targets: &state.targets,
+                        normals: &state.normals,
+                        colliders: &state.colliders,
+                        move_cs,
+                        rotate_cs,
+                        gravity_cs: gravity_cs(s, component),
+                        wind_cs: wind_cs(s, component),
+                        dt,
+                        dt_old: state.dt_old[ci],
+                        fixed: false,
+                    };
+                    step_chain(
+                        rig,
+                        ci,
+                        &input,
+                        &mut state.pos,
+                        &mut state.prev,
+                        &mut state.rng[ci],
+                    );
+                    state.dt_old[ci] = dt;
+                }
+                for p in points.clone() {
+                    state.dev[p] = state.pos[p] - state.targets[p];
+                    state.dev_before[p] = state.dev[p];
+                }
+            }
+            TimeMode::Fixed => run_fixed(rig, ci, state, component, dt),
+        }
+    }
+    // Guard: never let a non-finite value out; start again from the pose instead.
+    if points.clone().any(|p| !state.pos[p].is_finite()) {
+        state.teleports += 1;
+        reset_chain(rig, ci, state, component);
+    }
+    // Output: the animated pose plus the (interpolated) deviation, blended by alpha, with
+    // bone lengths restored from the root down.
+    let h = 1.0 / s.target_framerate;
+    let w = if s.mode == TimeMode::Fixed {
+        (state.accumulator[ci] / h).clamp(0.0, 1.0)
+    } else {
+        1.0
+    };
+    for p in points {
+        let t = state.targets[p];
+        let dev = state.dev_before[p].lerp(state.dev[p], w) * s.alpha;
+        let parent = rig.parent[p];
+        state.out[p] = if parent == NONE {
+            t
+        } else {
+            let pp = parent as usize;
+            let anim = t - state.targets[pp];
+            let restore = |x: Vec3| {
+                state.out[pp]
+                    + normalize_or(x - state.out[pp], normalize_or(anim, Vec3::Y)) * anim.length()
+            };
+            // The interpolated output also respects this frame's colliders.
+            let mut x = restore(t + dev);
+            let r = rig.radius[p];
+            for _ in 0..2 {
+                for &c in &rig.chains[ci].colliders {
+                    x = state.colliders[c].resolve(x, x, r);
+                }
+                x = restore(x);
+            }
+            for &c in &rig.chains[ci].colliders {
+                x = state.colliders[c].resolve(x, x, r);
+            }
+            x
+        };
+    }
+}
+
+fn slerp_angle(a: Quat, b: Quat) -> f32 {
+    let d = a.dot(b).abs().min(1.0);
+    2.0 * d.acos()
+}
+
+fn run_fixed(rig: &ChainRig, ci: usize, state: &mut ChainState, component: &Transform, dt: f32) {
+    let s = &rig.chains[ci].settings;
+    let h = 1.0 / s.target_framerate;
+    let acc_old = state.accumulator[ci];
+    let mut total = acc_old + dt;
+    let mut steps = (total / h + 1e-4).floor() as u32;
+    if steps > s.max_steps_per_frame {
+        // A hitch: drop the time we cannot afford, keep the most recent steps.
+        total -= (steps - s.max_steps_per_frame) as f32 * h;
+        steps = s.max_steps_per_frame;
+    }
+    let skipped = acc_old + dt - total;
+    let points = rig.chains[ci].points.clone();
+    for k in 1..=steps {
+        // Where this step ends between last frame (0) and this frame (1).
+        let end = k as f32 * h - acc_old + skipped;
+        let w = if dt > 0.0 {
+            (end / dt).clamp(0.0, 1.0)
+        } else {
+            1.0
+        };
+        for p in points.clone() {
+            state.step_targets[p] = state.prev_targets[p].lerp(state.targets[p], w);
+            state.step_normals[p] = normalize_or(
+                state.prev_normals[p].lerp(state.normals[p], w),
+                state.normals[p],
+            );
+        }
+        for &c in &rig.chains[ci].colliders {
+            state.step_colliders[c] =
+                lerp_collider(&state.prev_colliders[c], &state.colliders[c], w);
+        }
+        let comp_b = Transform::from_translation_rotation(
+            state
+                .prev_component
+                .translation
+                .lerp(component.translation, w),
+            slerp_shortest(state.prev_component.rotation, component.rotation, w),
+        );
+        let (move_cs, rotate_cs) = motion_cs(&state.last_step_component[ci], &comp_b);
+        let input = StepInput {
+            targets: &state.step_targets,
+            normals: &state.step_normals,
+            colliders: &state.step_colliders,
+            move_cs,
+            rotate_cs,
+            gravity_cs: gravity_cs(s, &comp_b),
+            wind_cs: wind_cs(s, &comp_b),
+            dt: h,
+            dt_old: h,
+            fixed: true,
+        };
+        step_chain(
+            rig,
+            ci,
+            &input,
+            &mut state.pos,
+            &mut state.prev,
+            &mut state.rng[ci],
+        );
+        state.last_step_component[ci] = comp_b;
+        for p in points.clone() {
+            state.dev_before[p] = state.dev[p];
+            state.dev[p] = state.pos[p] - state.step_targets[p];
+        }
+    }
+    state.accumulator[ci] = (total - steps as f32 * h).max(0.0);
+}
+
+/// Turns each simulated parent toward its simulated children (mean direction), on top of
+/// its animated rotation, and writes the local rotation.
+fn write_back(
+    sk: &Skeleton,
+    rig: &ChainRig,
+    targets: &[Vec3],
+    out: &[Vec3],
+    locals: &mut [Transform],
+    models: &mut [Transform],
+) {
+    for (joint, point, kids) in &rig.rotators {
+        let j = *joint as usize;
+        let p = *point as usize;
+        let mut anim = Vec3::ZERO;
+        let mut sim = Vec3::ZERO;
+        for &c in &rig.rotator_children[kids.start as usize..kids.end as usize] {
+            let c = c as usize;
+            anim += normalize_or(targets[c] - targets[p], Vec3::ZERO);
+            sim += normalize_or(out[c] - out[p], Vec3::ZERO);
+        }
+        if anim.length_squared() < 1e-12 || sim.length_squared() < 1e-12 {
+            continue;
+        }
+        let swing = rotation_arc(anim, sim);
+        let new_rot = (swing * models[j].rotation).normalize();
+        let parent_rot = sk
+            .parent(j)
+            .map(|q| models[q].rotation)
+            .unwrap_or(Quat::IDENTITY);
+        locals[j].rotation = (parent_rot.inverse() * new_rot).normalize();
+        models[j].rotation = new_rot;
+    }
+}

@@ -1,0 +1,16 @@
+//! Bone chains after KawaiiPhysics (seed 000): Verlet points on the real bones, damping,
+//! stiffness toward the animated pose with the frame-rate exponent, inertia from the
+//! character's own motion, gravity, wind, colliders, limits, teleport reset, two time modes
+//! and write-back of bone rotations.
+//!
+//! [`ChainRig`] is compiled once from [`RigSettings`](crate::dynamics::RigSettings) and a
+//! skeleton; [`ChainState`] is the small per-character state; [`ChainJob`] runs one frame.
+
+mod compile;
+mod job;
+mod settings;
+mod step;
+
+pub use compile::{ChainRig, PointInfo};
+pub use job::{ChainJob, ChainState};
+pub use settings::{ChainCurves, ChainSettings, PlanarAxis, TimeMode, Wind};

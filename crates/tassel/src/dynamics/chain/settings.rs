@@ -1,0 +1,244 @@
+//! Chain settings: plain, serde-able data, shared between characters.
+
+use crate::dynamics::Curve;
+use crate::error::{Error, Result};
+use glam::Vec3;
+use serde::{Deserialize, Serialize};
+
+/// How the solver advances time.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum TimeMode {
+    /// One step per rendered frame, exactly as KawaiiPhysics (seed 000) writes it; the look
+    /// depends on the frame rate.
+    Classic,
+    /// Steps of `1 / target_framerate` seconds with the animated targets interpolated across
+    /// the sub-steps and the output interpolated between the last two steps: the look no
+    /// longer depends on the frame rate.
+    #[default]
+    Fixed,
+}
+
+/// Restricts a bone to a plane through its parent, normal to one of the parent's animated
+/// axes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PlanarAxis {
+    /// No planar constraint.
+    #[default]
+    None,
+    /// Plane normal is the parent's local X axis.
+    X,
+    /// Plane normal is the parent's local Y axis.
+    Y,
+    /// Plane normal is the parent's local Z axis.
+    Z,
+}
+
+/// Wind: a push along a world direction with seeded random gusts.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Wind {
+    /// World-space direction (normalised on use; zero means no wind).
+    pub direction: Vec3,
+    /// Strength: displacement per target frame in metres before damping (≥ 0).
+    pub speed: f32,
+    /// Gust amount 0..=1: each point and step scales the wind by a random factor in
+    /// `[1 − gust, 1 + gust]` (KawaiiPhysics uses 1, i.e. `[0, 2]`).
+    pub gust: f32,
+    /// Seed of the gust generator.
+    pub seed: u64,
+}
+
+impl Default for Wind {
+    fn default() -> Self {
+        Self {
+            direction: Vec3::X,
+            speed: 0.0,
+            gust: 1.0,
+            seed: 1,
+        }
+    }
+}
+
+/// Parameter curves over the normalised chain length; each multiplies its base value.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ChainCurves {
+    /// Multiplies `damping`.
+    pub damping: Curve,
+    /// Multiplies `stiffness`.
+    pub stiffness: Curve,
+    /// Multiplies `radius`.
+    pub radius: Curve,
+    /// Multiplies `world_damping_location`.
+    pub world_damping_location: Curve,
+    /// Multiplies `world_damping_rotation`.
+    pub world_damping_rotation: Curve,
+    /// Multiplies `limit_angle`.
+    pub limit_angle: Curve,
+}
+
+/// One bone chain: a root bone and all its descendants (minus excluded subtrees).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ChainSettings {
+    /// A name for messages and output.
+    pub name: String,
+    /// The root bone: it stays animated and turns toward its simulated children.
+    pub root: String,
+    /// Bones whose subtrees are left out of the chain.
+    pub exclude: Vec<String>,
+    /// Velocity damping per step, 0..=1.
+    pub damping: f32,
+    /// Pull toward the animated pose, 0..=1 (1: the animated pose exactly).
+    pub stiffness: f32,
+    /// How much of the character's own translation the points ignore, 0..=1 (0: full
+    /// inertia, they stay where they were in the world; 1: they move with the character).
+    pub world_damping_location: f32,
+    /// The same for the character's rotation, 0..=1.
+    pub world_damping_rotation: f32,
+    /// Collision radius of each point, metres (≥ 0).
+    pub radius: f32,
+    /// Cone limit around the animated bone direction, degrees (0 = off, up to 180).
+    pub limit_angle: f32,
+    /// Parameter curves over the normalised length.
+    pub curves: ChainCurves,
+    /// Length of a virtual tip bone added after each leaf, metres (0 = none).
+    pub dummy_bone_length: f32,
+    /// Planar constraint axis.
+    pub planar_constraint: PlanarAxis,
+    /// Gravity. In `fixed` mode an acceleration (m/s²); in `classic` mode applied as
+    /// seed 000 writes it, `location += gravity · dt` each frame.
+    pub gravity: Vec3,
+    /// Gravity given in world space (true) or the character's space (false).
+    pub gravity_in_world: bool,
+    /// Wind.
+    pub wind: Wind,
+    /// The frame rate the parameters were tuned for (Hz, > 0); also the `fixed` step rate.
+    pub target_framerate: f32,
+    /// Time mode.
+    pub mode: TimeMode,
+    /// Character moves farther than this in one frame: reset to the animated pose
+    /// (metres; 0 = off).
+    pub teleport_distance: f32,
+    /// Character turns more than this in one frame: reset (degrees; 0 = off).
+    pub teleport_rotation: f32,
+    /// Steps run on the first frame and after each reset to settle the chain.
+    pub warmup_steps: u32,
+    /// Blend of the result with the animated pose, 0..=1 (1: fully simulated).
+    pub alpha: f32,
+    /// Colliders (by name from the rig) this chain collides with; empty: all of them.
+    pub colliders: Vec<String>,
+    /// `fixed` mode: at most this many steps per frame; time beyond is dropped (hitch guard).
+    pub max_steps_per_frame: u32,
+    /// `classic` mode: a longer frame is clamped to this, seconds.
+    pub max_delta_time: f32,
+}
+
+impl Default for ChainSettings {
+    fn default() -> Self {
+        Self {
+            name: String::new(),
+            root: String::new(),
+            exclude: Vec::new(),
+            damping: 0.1,
+            stiffness: 0.05,
+            world_damping_location: 0.8,
+            world_damping_rotation: 0.8,
+            radius: 0.02,
+            limit_angle: 0.0,
+            curves: ChainCurves::default(),
+            dummy_bone_length: 0.0,
+            planar_constraint: PlanarAxis::None,
+            gravity: Vec3::new(0.0, -9.81, 0.0),
+            gravity_in_world: true,
+            wind: Wind::default(),
+            target_framerate: 60.0,
+            mode: TimeMode::Fixed,
+            teleport_distance: 1.0,
+            teleport_rotation: 60.0,
+            warmup_steps: 0,
+            alpha: 1.0,
+            colliders: Vec::new(),
+            max_steps_per_frame: 10,
+            max_delta_time: 0.1,
+        }
+    }
+}
+
+impl ChainSettings {
+    /// Checks every parameter's range; the error names the chain and the parameter.
+    pub fn validate(&self) -> Result<()> {
+        let name = &self.name;
+        let bad = |m: String| Err(Error::InvalidParameter(format!("chain '{name}': {m}")));
+        for (param, v) in [
+            ("damping", self.damping),
+            ("stiffness", self.stiffness),
+            ("world_damping_location", self.world_damping_location),
+            ("world_damping_rotation", self.world_damping_rotation),
+            ("alpha", self.alpha),
+            ("wind.gust", self.wind.gust),
+        ] {
+            if !(0.0..=1.0).contains(&v) {
+                return bad(format!("{param} is {v}; it must be between 0 and 1"));
+            }
+        }
+        for (param, v) in [
+            ("radius", self.radius),
+            ("dummy_bone_length", self.dummy_bone_length),
+            ("teleport_distance", self.teleport_distance),
+            ("teleport_rotation", self.teleport_rotation),
+            ("wind.speed", self.wind.speed),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                return bad(format!("{param} is {v}; it must be finite and ≥ 0"));
+            }
+        }
+        if !(0.0..=180.0).contains(&self.limit_angle) {
+            return bad(format!(
+                "limit_angle is {}; it must be 0..=180 degrees",
+                self.limit_angle
+            ));
+        }
+        if !(self.target_framerate.is_finite()
+            && self.target_framerate >= 1.0
+            && self.target_framerate <= 10_000.0)
+        {
+            return bad(format!(
+                "target_framerate is {}; it must be 1..=10000 Hz",
+                self.target_framerate
+            ));
+        }
+        if !(self.max_delta_time.is_finite() && self.max_delta_time > 0.0) {
+            return bad(format!(
+                "max_delta_time is {}; it must be > 0",
+                self.max_delta_time
+            ));
+        }
+        if self.max_steps_per_frame == 0 {
+            return bad("max_steps_per_frame must be at least 1".into());
+        }
+        if !self.gravity.is_finite() {
+            return bad(format!("gravity {} is not finite", self.gravity));
+        }
+        if !self.wind.direction.is_finite() {
+            return bad(format!(
+                "wind.direction {} is not finite",
+                self.wind.direction
+            ));
+        }
+        let c = &self.curves;
+        for (param, curve) in [
+            ("curves.damping", &c.damping),
+            ("curves.stiffness", &c.stiffness),
+            ("curves.radius", &c.radius),
+            ("curves.world_damping_location", &c.world_damping_location),
+            ("curves.world_damping_rotation", &c.world_damping_rotation),
+            ("curves.limit_angle", &c.limit_angle),
+        ] {
+            curve.validate(&format!("chain '{name}': {param}"))?;
+        }
+        Ok(())
+    }
+}

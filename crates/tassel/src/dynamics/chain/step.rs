@@ -1,0 +1,130 @@
+//! One solver step of one chain: the readable, per-point reference path.
+
+use super::compile::{ChainRig, NONE};
+use super::settings::PlanarAxis;
+use crate::collide::PlacedCollider;
+use crate::math::normalize_or;
+use crate::rng::SplitMix64;
+use glam::{Quat, Vec3};
+
+/// Everything one step reads besides the rig and the points.
+pub(crate) struct StepInput<'a> {
+    /// Animated target positions of every point (model space) at the end of the step.
+    pub targets: &'a [Vec3],
+    /// Planar-constraint normals per point (the parent's animated axis).
+    pub normals: &'a [Vec3],
+    /// All colliders, placed at the end of the step.
+    pub colliders: &'a [PlacedCollider],
+    /// The old character origin seen from the new character space.
+    pub move_cs: Vec3,
+    /// The old character rotation seen from the new character space.
+    pub rotate_cs: Quat,
+    /// Gravity in character space.
+    pub gravity_cs: Vec3,
+    /// Wind direction in character space (unit or zero).
+    pub wind_cs: Vec3,
+    /// Step length and the previous step's length, seconds.
+    pub dt: f32,
+    pub dt_old: f32,
+    /// True in fixed mode (gravity as an acceleration).
+    pub fixed: bool,
+}
+
+/// Advances the points of chain `ci` by one step.
+pub(crate) fn step_chain(
+    rig: &ChainRig,
+    ci: usize,
+    input: &StepInput,
+    pos: &mut [Vec3],
+    prev: &mut [Vec3],
+    rng: &mut SplitMix64,
+) {
+    let chain = &rig.chains[ci];
+    let s = &chain.settings;
+    let exponent = s.target_framerate * input.dt;
+    let gravity_step = if input.fixed {
+        input.gravity_cs * input.dt * input.dt
+    } else {
+        input.gravity_cs * input.dt
+    };
+    let wind_on = s.wind.speed > 0.0 && input.wind_cs != Vec3::ZERO;
+    let t = input.targets;
+    for p in chain.points.clone() {
+        let parent = rig.parent[p];
+        if parent == NONE {
+            pos[p] = t[p];
+            prev[p] = t[p];
+            continue;
+        }
+        let pp = parent as usize;
+
+        // Verlet velocity from the previous position, damped.
+        let mut velocity = if input.dt_old > 0.0 {
+            (pos[p] - prev[p]) / input.dt_old
+        } else {
+            Vec3::ZERO
+        };
+        prev[p] = pos[p];
+        velocity *= 1.0 - rig.damping[p];
+        if wind_on {
+            let gust = rng.range_f32(1.0 - s.wind.gust, 1.0 + s.wind.gust);
+            velocity += input.wind_cs * s.wind.speed * gust * s.target_framerate;
+        }
+        let mut x = pos[p] + velocity * input.dt;
+
+        // Inertia: follow the character's translation and rotation only partly.
+        x += input.move_cs * (1.0 - rig.wd_location[p]);
+        x += (input.rotate_cs * prev[p] - prev[p]) * (1.0 - rig.wd_rotation[p]);
+        x += gravity_step;
+
+        // Pull toward the animated pose, relative to the simulated parent.
+        let base = pos[pp] + (t[p] - t[pp]);
+        let k = rig.stiffness[p];
+        let pull = if k >= 1.0 {
+            1.0
+        } else {
+            1.0 - (1.0 - k).powf(exponent)
+        };
+        x += (base - x) * pull;
+
+        let r = rig.radius[p];
+        let collide = |mut x: Vec3| {
+            for &c in &chain.colliders {
+                x = input.colliders[c].resolve(x, prev[p], r);
+            }
+            x
+        };
+        x = collide(x);
+
+        // Cone limit around the animated direction.
+        let anim_dir = t[p] - t[pp];
+        let limit = rig.limit_angle[p];
+        if limit > 0.0 {
+            let d = x - pos[pp];
+            let angle = d.angle_between(anim_dir);
+            if angle.is_finite() && angle > limit {
+                let axis = normalize_or(anim_dir.cross(d), anim_dir.any_orthonormal_vector());
+                let dir = Quat::from_axis_angle(axis, limit) * normalize_or(anim_dir, Vec3::Y);
+                x = pos[pp] + dir * d.length();
+            }
+        }
+        if s.planar_constraint != PlanarAxis::None {
+            let n = input.normals[p];
+            x -= n * (x - pos[pp]).dot(n);
+        }
+
+        // Keep the bone length, then settle collisions against the length a few times;
+        // collisions get the last word.
+        let length = anim_dir.length();
+        let fallback = normalize_or(anim_dir, Vec3::Y);
+        let restore = |x: Vec3| pos[pp] + normalize_or(x - pos[pp], fallback) * length;
+        x = restore(x);
+        if !chain.colliders.is_empty() {
+            for _ in 0..3 {
+                x = restore(collide(x));
+            }
+            x = collide(x);
+        }
+        pos[p] = x;
+    }
+}

@@ -1,0 +1,171 @@
+//! The rig file: chains and colliders attached to a skeleton by bone names (TOML; see
+//! docs/rig.md).
+
+use crate::collide::Shape;
+use crate::dynamics::chain::ChainSettings;
+use crate::error::{Error, Result};
+use crate::skeleton::Skeleton;
+use glam::{Quat, Vec3};
+use serde::{Deserialize, Serialize};
+
+/// A collider attached to a bone.
+// No `deny_unknown_fields` here: serde does not support it together with the flattened
+// shape.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ColliderSettings {
+    /// Name, referenced by chains' `colliders` lists.
+    pub name: String,
+    /// The bone it follows (its animated pose).
+    pub bone: String,
+    /// Offset from the bone in the bone's space, metres.
+    #[serde(default)]
+    pub offset: Vec3,
+    /// Rotation relative to the bone, `[x, y, z, w]`.
+    #[serde(default = "identity")]
+    pub rotation: Quat,
+    /// The shape.
+    #[serde(flatten)]
+    pub shape: Shape,
+}
+
+fn identity() -> Quat {
+    Quat::IDENTITY
+}
+
+/// Everything a rig file holds.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RigSettings {
+    /// Bone chains (`[[chain]]` tables).
+    #[serde(default, rename = "chain")]
+    pub chains: Vec<ChainSettings>,
+    /// Colliders (`[[collider]]` tables).
+    #[serde(default, rename = "collider")]
+    pub colliders: Vec<ColliderSettings>,
+}
+
+impl RigSettings {
+    /// Parses a rig from TOML text and checks every parameter.
+    pub fn from_toml_str(text: &str) -> Result<Self> {
+        let rig: RigSettings = toml::from_str(text).map_err(|e| Error::RigParse(e.to_string()))?;
+        rig.validate()?;
+        Ok(rig)
+    }
+
+    /// The rig as TOML text.
+    pub fn to_toml_string(&self) -> Result<String> {
+        toml::to_string(self).map_err(|e| Error::RigParse(e.to_string()))
+    }
+
+    /// Checks parameter ranges and internal references (not bone names: see
+    /// [`RigSettings::validate_for`]).
+    pub fn validate(&self) -> Result<()> {
+        for c in &self.chains {
+            c.validate()?;
+        }
+        for (i, col) in self.colliders.iter().enumerate() {
+            let what = format!("collider '{}'", col.name);
+            col.shape.validate(&what)?;
+            if !col.offset.is_finite() || !col.rotation.is_finite() || col.rotation.length() < 1e-6
+            {
+                return Err(Error::InvalidParameter(format!(
+                    "{what}: offset or rotation is not finite"
+                )));
+            }
+            if self.colliders[..i].iter().any(|o| o.name == col.name) {
+                return Err(Error::InvalidParameter(format!(
+                    "two colliders are named '{}'",
+                    col.name
+                )));
+            }
+        }
+        for c in &self.chains {
+            for name in &c.colliders {
+                if !self.colliders.iter().any(|o| &o.name == name) {
+                    return Err(Error::InvalidParameter(format!(
+                        "chain '{}' names collider '{name}', which the rig does not define",
+                        c.name
+                    )));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// [`RigSettings::validate`] plus every bone name checked against `skeleton`.
+    pub fn validate_for(&self, skeleton: &Skeleton) -> Result<()> {
+        self.validate()?;
+        let need = |context: String, name: &str| {
+            skeleton
+                .find(name)
+                .map(|_| ())
+                .ok_or_else(|| Error::MissingBone {
+                    context,
+                    name: name.to_string(),
+                })
+        };
+        for c in &self.chains {
+            need(format!("chain '{}' root", c.name), &c.root)?;
+            for e in &c.exclude {
+                need(format!("chain '{}' exclude", c.name), e)?;
+            }
+        }
+        for col in &self.colliders {
+            need(format!("collider '{}' bone", col.name), &col.bone)?;
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const RIG: &str = r#"
+[[chain]]
+name = "tail"
+root = "tail_0"
+damping = 0.2
+curves.stiffness = [[0.0, 1.0], [1.0, 0.5]]
+
+[[collider]]
+name = "hips"
+bone = "hips"
+shape = "capsule"
+radius = 0.1
+length = 0.2
+offset = [0.0, 0.05, 0.0]
+"#;
+
+    #[test]
+    fn parses_with_defaults() {
+        let rig = RigSettings::from_toml_str(RIG).unwrap();
+        assert_eq!(rig.chains[0].damping, 0.2);
+        assert_eq!(rig.chains[0].stiffness, ChainSettings::default().stiffness);
+        assert_eq!(rig.chains[0].curves.stiffness.eval(0.5), 0.75);
+        assert_eq!(
+            rig.colliders[0].shape,
+            Shape::Capsule {
+                radius: 0.1,
+                length: 0.2
+            }
+        );
+        let again = RigSettings::from_toml_str(&rig.to_toml_string().unwrap()).unwrap();
+        assert_eq!(again, rig);
+    }
+
+    #[test]
+    fn rejects_bad_values_by_name() {
+        let neg = RIG.replace("radius = 0.1", "radius = -0.1");
+        let e = RigSettings::from_toml_str(&neg).unwrap_err().to_string();
+        assert!(e.contains("hips") && e.contains("radius"), "{e}");
+        let nan = RIG.replace("damping = 0.2", "damping = nan");
+        let e = RigSettings::from_toml_str(&nan).unwrap_err().to_string();
+        assert!(e.contains("damping"), "{e}");
+        let typo = RIG.replace("damping = 0.2", "dampnig = 0.2");
+        assert!(matches!(
+            RigSettings::from_toml_str(&typo),
+            Err(Error::RigParse(_))
+        ));
+    }
+}

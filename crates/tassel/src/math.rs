@@ -1,0 +1,290 @@
+//! Small math helpers on top of glam: a TRS [`Transform`], the shortest-arc rotation and
+//! safe normalisation used throughout the solvers.
+
+use glam::{Mat4, Quat, Vec3};
+use serde::{Deserialize, Serialize};
+
+/// A translation, rotation and (possibly non-uniform) scale, applied as scale, then
+/// rotation, then translation, like a glTF node.
+///
+/// Composition follows the usual game-engine rule (scale does not shear);
+/// `(a * b).relative_to(&a) == b` holds for any `b`, and `a.inverse() * (a * b) == b` when
+/// `a`'s scale is uniform.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Transform {
+    /// Translation, in the parent's units (metres for glTF files).
+    pub translation: Vec3,
+    /// Rotation (unit quaternion).
+    pub rotation: Quat,
+    /// Scale per local axis.
+    pub scale: Vec3,
+}
+
+impl Default for Transform {
+    fn default() -> Self {
+        Self::IDENTITY
+    }
+}
+
+impl Transform {
+    /// The transform that changes nothing.
+    pub const IDENTITY: Transform = Transform {
+        translation: Vec3::ZERO,
+        rotation: Quat::IDENTITY,
+        scale: Vec3::ONE,
+    };
+
+    /// A transform from its three parts.
+    pub fn new(translation: Vec3, rotation: Quat, scale: Vec3) -> Self {
+        Self {
+            translation,
+            rotation,
+            scale,
+        }
+    }
+
+    /// A pure translation.
+    pub fn from_translation(translation: Vec3) -> Self {
+        Self {
+            translation,
+            ..Self::IDENTITY
+        }
+    }
+
+    /// A translation and a rotation, unit scale.
+    pub fn from_translation_rotation(translation: Vec3, rotation: Quat) -> Self {
+        Self {
+            translation,
+            rotation,
+            scale: Vec3::ONE,
+        }
+    }
+
+    /// Maps a point from this transform's local space to its parent space.
+    #[inline]
+    pub fn transform_point(&self, p: Vec3) -> Vec3 {
+        self.translation + self.rotation * (self.scale * p)
+    }
+
+    /// Maps a direction (no translation) from local to parent space.
+    #[inline]
+    pub fn transform_vector(&self, v: Vec3) -> Vec3 {
+        self.rotation * (self.scale * v)
+    }
+
+    /// Maps a point from parent space back into this transform's local space.
+    #[inline]
+    pub fn inverse_transform_point(&self, p: Vec3) -> Vec3 {
+        (self.rotation.inverse() * (p - self.translation)) / self.scale
+    }
+
+    /// The inverse under this type's composition rule (exact for uniform scale; use
+    /// [`Transform::relative_to`] for the exact model→local step).
+    pub fn inverse(&self) -> Transform {
+        let inv_r = self.rotation.inverse();
+        let inv_s = self.scale.recip();
+        Transform {
+            translation: inv_s * (inv_r * -self.translation),
+            rotation: inv_r,
+            scale: inv_s,
+        }
+    }
+
+    /// `self * child`: the child's transform expressed in this transform's parent space.
+    #[inline]
+    pub fn mul_transform(&self, child: &Transform) -> Transform {
+        Transform {
+            translation: self.transform_point(child.translation),
+            rotation: (self.rotation * child.rotation).normalize(),
+            scale: self.scale * child.scale,
+        }
+    }
+
+    /// `parent.inverse() * self`, computed directly: this model-space transform seen from
+    /// `parent`'s space.
+    #[inline]
+    pub fn relative_to(&self, parent: &Transform) -> Transform {
+        let inv_r = parent.rotation.inverse();
+        Transform {
+            translation: (inv_r * (self.translation - parent.translation)) / parent.scale,
+            rotation: (inv_r * self.rotation).normalize(),
+            scale: self.scale / parent.scale,
+        }
+    }
+
+    /// The 4×4 matrix of this transform.
+    pub fn to_mat4(&self) -> Mat4 {
+        Mat4::from_scale_rotation_translation(self.scale, self.rotation, self.translation)
+    }
+
+    /// Linear blend of translation and scale, shortest-path slerp of rotation.
+    pub fn lerp(&self, other: &Transform, t: f32) -> Transform {
+        Transform {
+            translation: self.translation.lerp(other.translation, t),
+            rotation: slerp_shortest(self.rotation, other.rotation, t),
+            scale: self.scale.lerp(other.scale, t),
+        }
+    }
+
+    /// True when every component is finite.
+    pub fn is_finite(&self) -> bool {
+        self.translation.is_finite() && self.rotation.is_finite() && self.scale.is_finite()
+    }
+}
+
+impl core::ops::Mul for Transform {
+    type Output = Transform;
+    fn mul(self, rhs: Transform) -> Transform {
+        self.mul_transform(&rhs)
+    }
+}
+
+/// Slerp that always takes the shorter way round (flips `b` into `a`'s hemisphere).
+pub fn slerp_shortest(a: Quat, b: Quat, t: f32) -> Quat {
+    let b = if a.dot(b) < 0.0 { -b } else { b };
+    a.slerp(b, t).normalize()
+}
+
+/// Normalises `v`, or returns `fallback` when `v` is too short to have a direction.
+#[inline]
+pub fn normalize_or(v: Vec3, fallback: Vec3) -> Vec3 {
+    let len2 = v.length_squared();
+    if len2 > 1e-20 && len2.is_finite() {
+        v / len2.sqrt()
+    } else {
+        fallback
+    }
+}
+
+/// The smallest rotation that takes direction `from` to direction `to` (both non-zero).
+/// Antiparallel inputs turn about an axis perpendicular to `from`.
+pub fn rotation_arc(from: Vec3, to: Vec3) -> Quat {
+    let a = normalize_or(from, Vec3::Y);
+    let b = normalize_or(to, a);
+    let d = a.dot(b);
+    if d > 1.0 - 1e-7 {
+        Quat::IDENTITY
+    } else if d < -1.0 + 1e-6 {
+        Quat::from_axis_angle(a.any_orthonormal_vector(), core::f32::consts::PI)
+    } else {
+        Quat::from_rotation_arc(a, b)
+    }
+}
+
+/// Closest point to `p` on the segment `a`–`b`.
+#[inline]
+pub fn closest_point_on_segment(p: Vec3, a: Vec3, b: Vec3) -> Vec3 {
+    let ab = b - a;
+    let len2 = ab.length_squared();
+    if len2 <= 1e-20 {
+        return a;
+    }
+    let t = ((p - a).dot(ab) / len2).clamp(0.0, 1.0);
+    a + ab * t
+}
+
+/// Closest points between segments `p1`–`q1` and `p2`–`q2` (Ericson, Real-Time Collision
+/// Detection §5.1.9). Returns the parameters `(s, t)` along each segment.
+pub fn closest_params_segment_segment(p1: Vec3, q1: Vec3, p2: Vec3, q2: Vec3) -> (f32, f32) {
+    let d1 = q1 - p1;
+    let d2 = q2 - p2;
+    let r = p1 - p2;
+    let a = d1.dot(d1);
+    let e = d2.dot(d2);
+    let f = d2.dot(r);
+    const EPS: f32 = 1e-12;
+    if a <= EPS && e <= EPS {
+        return (0.0, 0.0);
+    }
+    if a <= EPS {
+        return (0.0, (f / e).clamp(0.0, 1.0));
+    }
+    let c = d1.dot(r);
+    if e <= EPS {
+        return ((-c / a).clamp(0.0, 1.0), 0.0);
+    }
+    let b = d1.dot(d2);
+    let denom = a * e - b * b;
+    let mut s = if denom > EPS {
+        ((b * f - c * e) / denom).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let mut t = (b * s + f) / e;
+    if t < 0.0 {
+        t = 0.0;
+        s = (-c / a).clamp(0.0, 1.0);
+    } else if t > 1.0 {
+        t = 1.0;
+        s = ((b - c) / a).clamp(0.0, 1.0);
+    }
+    (s, t)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn inverse_undoes_composition() {
+        let a = Transform::new(
+            Vec3::new(1.0, 2.0, 3.0),
+            Quat::from_euler(glam::EulerRot::XYZ, 0.3, -0.7, 1.1),
+            Vec3::new(2.0, 0.5, 1.5),
+        );
+        let b = Transform::new(
+            Vec3::new(-0.4, 0.2, 0.9),
+            Quat::from_rotation_y(0.5),
+            Vec3::splat(1.3),
+        );
+        let rel = (a * b).relative_to(&a);
+        assert!(rel.translation.abs_diff_eq(b.translation, 1e-5));
+        assert!(rel.rotation.abs_diff_eq(b.rotation, 1e-5));
+        assert!(rel.scale.abs_diff_eq(b.scale, 1e-5));
+        let uniform = Transform {
+            scale: Vec3::splat(2.0),
+            ..a
+        };
+        let back = uniform.inverse() * (uniform * b);
+        assert!(back.translation.abs_diff_eq(b.translation, 1e-5));
+        assert!(back.rotation.abs_diff_eq(b.rotation, 1e-5));
+    }
+
+    #[test]
+    fn rotation_arc_maps_directions() {
+        let cases = [
+            (Vec3::X, Vec3::Y),
+            (Vec3::new(1.0, 2.0, 3.0), Vec3::new(-3.0, 0.5, 0.1)),
+            (Vec3::Z, -Vec3::Z),
+            (Vec3::Y, Vec3::Y),
+        ];
+        for (a, b) in cases {
+            let q = rotation_arc(a, b);
+            assert!(
+                (q * a.normalize()).abs_diff_eq(b.normalize(), 1e-5),
+                "{a} -> {b}"
+            );
+        }
+    }
+
+    #[test]
+    fn slerp_takes_short_way() {
+        let a = Quat::from_rotation_z(0.1);
+        let b = -Quat::from_rotation_z(0.3); // same rotation, other hemisphere
+        let mid = slerp_shortest(a, b, 0.5);
+        let expected = Quat::from_rotation_z(0.2);
+        assert!(mid.dot(expected).abs() > 1.0 - 1e-6);
+    }
+
+    #[test]
+    fn segment_segment_closest() {
+        // Two perpendicular segments crossing above each other at distance 1.
+        let (s, t) = closest_params_segment_segment(
+            Vec3::new(-1.0, 0.0, 0.0),
+            Vec3::new(1.0, 0.0, 0.0),
+            Vec3::new(0.0, 1.0, -1.0),
+            Vec3::new(0.0, 1.0, 1.0),
+        );
+        assert!((s - 0.5).abs() < 1e-6 && (t - 0.5).abs() < 1e-6);
+    }
+}
