@@ -1,0 +1,315 @@
+//! Reading glTF / GLB into a skeleton, skins and clips.
+
+use crate::error::GltfError;
+use base64::Engine;
+use glam::{Mat4, Quat, Vec3};
+use std::path::Path;
+use tassel::anim::{Channel, Clip, Interpolation, JointTrack};
+use tassel::{Skeleton, SkeletonBuilder, Transform};
+
+/// One skin of the file.
+#[derive(Debug, Clone)]
+pub struct SkinInfo {
+    /// The skin's name.
+    pub name: String,
+    /// Its joints, as skeleton indices.
+    pub joints: Vec<usize>,
+    /// One inverse bind matrix per joint (identity when the file gives none).
+    pub inverse_bind: Vec<Mat4>,
+}
+
+/// A loaded glTF file: every node is a joint of `skeleton`.
+#[derive(Debug, Clone)]
+pub struct Model {
+    /// All nodes, depth-first.
+    pub skeleton: Skeleton,
+    /// glTF node index → skeleton joint.
+    pub node_to_joint: Vec<usize>,
+    /// Skeleton joint → glTF node index.
+    pub joint_to_node: Vec<usize>,
+    /// The file's skins.
+    pub skins: Vec<SkinInfo>,
+    /// The file's animations as clips over skeleton joints.
+    pub clips: Vec<Clip>,
+    /// Things the loader accepted but a user should know.
+    pub warnings: Vec<String>,
+    /// The parsed JSON and resolved buffers, for export.
+    pub source: crate::ExportSource,
+}
+
+/// Loads a `.gltf`, `.glb` or `.vrm` file.
+pub fn load(path: &Path) -> Result<Model, GltfError> {
+    let bytes = std::fs::read(path).map_err(|source| GltfError::Io {
+        path: path.display().to_string(),
+        source,
+    })?;
+    load_slice(&bytes, path.parent(), &path.display().to_string())
+}
+
+/// Loads from bytes; `base_dir` resolves external buffers; `name` is used in messages.
+pub fn load_slice(bytes: &[u8], base_dir: Option<&Path>, name: &str) -> Result<Model, GltfError> {
+    let invalid = |message: String| GltfError::Invalid {
+        path: name.to_string(),
+        message,
+    };
+    let gltf = gltf::Gltf::from_slice(bytes).map_err(|e| invalid(e.to_string()))?;
+    let doc = &gltf.document;
+    let mut buffers: Vec<Vec<u8>> = Vec::new();
+    for b in doc.buffers() {
+        let data = match b.source() {
+            gltf::buffer::Source::Bin => gltf
+                .blob
+                .clone()
+                .ok_or_else(|| invalid("GLB has no BIN chunk".into()))?,
+            gltf::buffer::Source::Uri(uri) => read_uri(uri, base_dir).map_err(invalid)?,
+        };
+        if data.len() < b.length() {
+            return Err(invalid(format!(
+                "buffer {} holds {} bytes, {} declared",
+                b.index(),
+                data.len(),
+                b.length()
+            )));
+        }
+        buffers.push(data);
+    }
+    // Accessor reads must stay inside the buffers: check views first so the reader never
+    // sees an out-of-range view.
+    for v in doc.views() {
+        let end = v.offset() + v.length();
+        if end > buffers[v.buffer().index()].len() {
+            return Err(invalid(format!(
+                "bufferView {} runs past the end of its buffer",
+                v.index()
+            )));
+        }
+    }
+
+    let mut warnings = Vec::new();
+    let node_count = doc.nodes().len();
+    if node_count == 0 {
+        return Err(invalid("the file has no nodes".into()));
+    }
+    let mut parent_of: Vec<Option<usize>> = vec![None; node_count];
+    for n in doc.nodes() {
+        for c in n.children() {
+            if let Some(p) = parent_of[c.index()] {
+                return Err(invalid(format!(
+                    "node {} has two parents ({p} and {})",
+                    c.index(),
+                    n.index()
+                )));
+            }
+            parent_of[c.index()] = Some(n.index());
+        }
+    }
+    let mut builder = SkeletonBuilder::new();
+    let mut seen = std::collections::HashSet::new();
+    for n in doc.nodes() {
+        let base = n
+            .name()
+            .map(str::to_string)
+            .unwrap_or_else(|| format!("node{}", n.index()));
+        let name = if seen.contains(&base) {
+            let renamed = format!("{base}#{}", n.index());
+            warnings.push(format!(
+                "node {} repeats the name '{base}'; called '{renamed}'",
+                n.index()
+            ));
+            renamed
+        } else {
+            base
+        };
+        seen.insert(name.clone());
+        let (t, r, s) = n.transform().decomposed();
+        let rest = Transform::new(
+            Vec3::from(t),
+            Quat::from_array(r).normalize(),
+            Vec3::from(s),
+        );
+        if !rest.is_finite() {
+            return Err(invalid(format!(
+                "node {} has a non-finite transform",
+                n.index()
+            )));
+        }
+        let sc = Vec3::from(s);
+        if sc.min_element() < 0.01 || sc.max_element() > 100.0 {
+            warnings.push(format!("node '{name}' has an unusual scale {sc}"));
+        }
+        builder.add(name, parent_of[n.index()], rest);
+    }
+    let (skeleton, node_to_joint) = builder.build().map_err(|source| GltfError::Skeleton {
+        path: name.to_string(),
+        source,
+    })?;
+    let mut joint_to_node = vec![0; node_count];
+    for (node, &j) in node_to_joint.iter().enumerate() {
+        joint_to_node[j] = node;
+    }
+
+    let get = |b: gltf::Buffer| buffers.get(b.index()).map(|v| v.as_slice());
+    let mut skins = Vec::new();
+    for skin in doc.skins() {
+        let joints: Vec<usize> = skin.joints().map(|j| node_to_joint[j.index()]).collect();
+        let inverse_bind: Vec<Mat4> = match skin.reader(get).read_inverse_bind_matrices() {
+            Some(it) => it.map(|m| Mat4::from_cols_array_2d(&m)).collect(),
+            None => vec![Mat4::IDENTITY; joints.len()],
+        };
+        if inverse_bind.len() < joints.len() {
+            return Err(invalid(format!(
+                "skin {} has fewer inverse bind matrices than joints",
+                skin.index()
+            )));
+        }
+        skins.push(SkinInfo {
+            name: skin.name().unwrap_or("").to_string(),
+            joints,
+            inverse_bind,
+        });
+    }
+
+    let mut clips = Vec::new();
+    for anim in doc.animations() {
+        let clip_name = anim
+            .name()
+            .map(str::to_string)
+            .unwrap_or_else(|| format!("animation_{}", anim.index()));
+        let mut tracks: Vec<JointTrack> = Vec::new();
+        let mut duration = 0.0f32;
+        for ch in anim.channels() {
+            let joint = node_to_joint[ch.target().node().index()];
+            let interpolation = match ch.sampler().interpolation() {
+                gltf::animation::Interpolation::Step => Interpolation::Step,
+                gltf::animation::Interpolation::Linear => Interpolation::Linear,
+                gltf::animation::Interpolation::CubicSpline => Interpolation::CubicSpline,
+            };
+            let reader = ch.reader(get);
+            let times: Vec<f32> = reader
+                .read_inputs()
+                .ok_or_else(|| invalid(format!("animation '{clip_name}': unreadable key times")))?
+                .collect();
+            duration = duration.max(times.last().copied().unwrap_or(0.0));
+            let idx = match tracks.iter().position(|t| t.joint == joint) {
+                Some(i) => i,
+                None => {
+                    tracks.push(JointTrack {
+                        joint,
+                        translation: None,
+                        rotation: None,
+                        scale: None,
+                    });
+                    tracks.len() - 1
+                }
+            };
+            let track = &mut tracks[idx];
+            use gltf::animation::util::ReadOutputs;
+            let what = format!(
+                "animation '{clip_name}' node {}",
+                ch.target().node().index()
+            );
+            match reader.read_outputs() {
+                Some(ReadOutputs::Translations(it)) => {
+                    let c = Channel {
+                        interpolation,
+                        times,
+                        values: it.map(Vec3::from).collect(),
+                    };
+                    c.validate(&what).map_err(|e| invalid(e.to_string()))?;
+                    track.translation = Some(c);
+                }
+                Some(ReadOutputs::Rotations(it)) => {
+                    let c = Channel {
+                        interpolation,
+                        times,
+                        values: it.into_f32().map(Quat::from_array).collect(),
+                    };
+                    c.validate(&what).map_err(|e| invalid(e.to_string()))?;
+                    track.rotation = Some(c);
+                }
+                Some(ReadOutputs::Scales(it)) => {
+                    let c = Channel {
+                        interpolation,
+                        times,
+                        values: it.map(Vec3::from).collect(),
+                    };
+                    c.validate(&what).map_err(|e| invalid(e.to_string()))?;
+                    track.scale = Some(c);
+                }
+                Some(ReadOutputs::MorphTargetWeights(_)) => {
+                    warnings.push(format!("{what}: morph target weights are not imported"));
+                }
+                None => return Err(invalid(format!("{what}: unreadable key values"))),
+            }
+        }
+        clips.push(Clip {
+            name: clip_name,
+            duration,
+            tracks,
+        });
+    }
+    for ext in doc.extensions_used() {
+        if !ext.starts_with("KHR_") && !ext.starts_with("VRMC_") && ext != "VRM" {
+            warnings.push(format!(
+                "extension '{ext}' is carried over but not interpreted"
+            ));
+        }
+    }
+    let json: serde_json::Value =
+        serde_json::to_value(doc.as_json()).map_err(|e| invalid(e.to_string()))?;
+    let json = raw_json(bytes).unwrap_or(json);
+    Ok(Model {
+        skeleton,
+        node_to_joint,
+        joint_to_node,
+        skins,
+        clips,
+        warnings,
+        source: crate::ExportSource {
+            json,
+            buffers,
+            base_dir: base_dir.map(Path::to_path_buf),
+        },
+    })
+}
+
+/// The document's JSON exactly as written (keeps extensions the typed model drops).
+fn raw_json(bytes: &[u8]) -> Option<serde_json::Value> {
+    if bytes.starts_with(b"glTF") {
+        let len = u32::from_le_bytes(bytes.get(12..16)?.try_into().ok()?) as usize;
+        serde_json::from_slice(bytes.get(20..20 + len)?).ok()
+    } else {
+        serde_json::from_slice(bytes).ok()
+    }
+}
+
+fn read_uri(uri: &str, base_dir: Option<&Path>) -> Result<Vec<u8>, String> {
+    if let Some(rest) = uri.strip_prefix("data:") {
+        let (_, payload) = rest
+            .split_once(";base64,")
+            .ok_or_else(|| format!("data URI without base64: {}", &uri[..uri.len().min(40)]))?;
+        return base64::engine::general_purpose::STANDARD
+            .decode(payload)
+            .map_err(|e| format!("bad base64 in data URI: {e}"));
+    }
+    let path = base_dir.unwrap_or(Path::new(".")).join(percent_decode(uri));
+    std::fs::read(&path).map_err(|e| format!("buffer '{}': {e}", path.display()))
+}
+
+fn percent_decode(s: &str) -> String {
+    let b = s.as_bytes();
+    let mut out = Vec::with_capacity(b.len());
+    let mut i = 0;
+    while i < b.len() {
+        if b[i] == b'%' && i + 2 < b.len() {
+            if let Ok(v) = u8::from_str_radix(&s[i + 1..i + 3], 16) {
+                out.push(v);
+                i += 3;
+                continue;
+            }
+        }
+        out.push(b[i]);
+        i += 1;
+    }
+    String::from_utf8_lossy(&out).into_owned()
+}
