@@ -167,12 +167,12 @@ fn add_bone_mesh(src: &mut ExportSource, sk: &Skeleton) {
     let root = (0..sk.len()).find(|&i| sk.parent(i).is_none()).unwrap_or(0);
     json["skins"] = json!([{ "name": "skeleton", "joints": (0..sk.len()).collect::<Vec<_>>(), "inverseBindMatrices": a_ibm, "skeleton": root }]);
     let mesh_node = json["nodes"].as_array().map(|a| a.len()).unwrap_or(0);
-    json["nodes"]
-        .as_array_mut()
-        .map(|a| a.push(json!({ "name": "bones", "mesh": 0, "skin": 0 })));
-    json["scenes"][0]["nodes"]
-        .as_array_mut()
-        .map(|a| a.push(json!(mesh_node)));
+    if let Some(a) = json["nodes"].as_array_mut() {
+        a.push(json!({ "name": "bones", "mesh": 0, "skin": 0 }));
+    }
+    if let Some(a) = json["scenes"][0]["nodes"].as_array_mut() {
+        a.push(json!(mesh_node));
+    }
 }
 
 fn f32_bytes(v: &[f32]) -> Vec<u8> {
@@ -294,7 +294,9 @@ fn merge_buffers(src: &ExportSource) -> Result<ExportSource, GltfError> {
         };
         let view = Writer::new(&mut out).view(&bytes, None);
         let img = &mut out.json["images"][i];
-        img.as_object_mut().map(|o| o.remove("uri"));
+        if let Some(o) = img.as_object_mut() {
+            o.remove("uri");
+        }
         img["bufferView"] = json!(view);
         img["mimeType"] = json!(mime);
     }

@@ -1,1 +1,600 @@
-//! Builtin character.
+//! The embedded default character: a small humanoid with a ponytail, two side locks, a
+//! tail, a skirt ring, two chest bones and body colliders, procedural clips (idle, walk,
+//! run, jump), and the scripted run of `tassel demo`. Built in code; no file needed.
+
+use crate::anim::{Channel, Clip, Interpolation, JointTrack};
+use crate::collide::Shape;
+use crate::dynamics::chain::ChainSettings;
+use crate::dynamics::{ColliderSettings, Curve, RigSettings};
+use crate::math::Transform;
+use crate::skeleton::{Skeleton, SkeletonBuilder};
+use glam::{EulerRot, Quat, Vec3};
+use std::f32::consts::{PI, TAU};
+
+/// The embedded character.
+#[derive(Debug, Clone)]
+pub struct Character {
+    /// Skeleton (metres, Y up, facing +Z).
+    pub skeleton: Skeleton,
+    /// Chains and colliders.
+    pub rig: RigSettings,
+    /// Clips, in order: idle, walk, run, jump.
+    pub clips: Vec<Clip>,
+}
+
+/// Index of each clip in [`Character::clips`].
+pub mod clip {
+    /// Breathing in place, 2 s loop.
+    pub const IDLE: usize = 0;
+    /// Walk cycle, 1 s loop.
+    pub const WALK: usize = 1;
+    /// Run cycle, 0.7 s loop.
+    pub const RUN: usize = 2;
+    /// Crouch, take-off, tuck and landing, 1.2 s.
+    pub const JUMP: usize = 3;
+}
+
+fn skeleton() -> Skeleton {
+    let mut b = SkeletonBuilder::new();
+    let t = |x: f32, y: f32, z: f32| Transform::from_translation(Vec3::new(x, y, z));
+    let root = b.add("root", None, Transform::IDENTITY);
+    let hips = b.add("hips", Some(root), t(0.0, 0.95, 0.0));
+    let spine = b.add("spine", Some(hips), t(0.0, 0.1, 0.0));
+    let chest = b.add("chest", Some(spine), t(0.0, 0.15, 0.0));
+    let neck = b.add("neck", Some(chest), t(0.0, 0.17, 0.0));
+    let head = b.add("head", Some(neck), t(0.0, 0.08, 0.0));
+    b.add("head_end", Some(head), t(0.0, 0.2, 0.0));
+    let mut p = b.add("ponytail_0", Some(head), t(0.0, 0.15, -0.11));
+    for i in 1..6 {
+        p = b.add(format!("ponytail_{i}"), Some(p), t(0.0, -0.065, -0.02));
+    }
+    for (side, x) in [("l", 1.0f32), ("r", -1.0)] {
+        let mut p = b.add(
+            format!("lock_{side}_0"),
+            Some(head),
+            t(0.085 * x, 0.06, 0.05),
+        );
+        for i in 1..3 {
+            p = b.add(
+                format!("lock_{side}_{i}"),
+                Some(p),
+                t(0.005 * x, -0.06, 0.0),
+            );
+        }
+        b.add(
+            format!("chest_{side}"),
+            Some(chest),
+            t(0.07 * x, 0.03, 0.07),
+        );
+        let sh = b.add(
+            format!("shoulder_{side}"),
+            Some(chest),
+            t(0.08 * x, 0.13, 0.0),
+        );
+        let ua = b.add(format!("upper_arm_{side}"), Some(sh), t(0.1 * x, 0.0, 0.0));
+        let la = b.add(format!("lower_arm_{side}"), Some(ua), t(0.0, -0.28, 0.0));
+        b.add(format!("hand_{side}"), Some(la), t(0.0, -0.25, 0.0));
+        let th = b.add(format!("thigh_{side}"), Some(hips), t(0.09 * x, -0.05, 0.0));
+        let sh = b.add(format!("shin_{side}"), Some(th), t(0.0, -0.42, 0.0));
+        let ft = b.add(format!("foot_{side}"), Some(sh), t(0.0, -0.42, 0.0));
+        b.add(format!("toe_{side}"), Some(ft), t(0.0, -0.05, 0.12));
+    }
+    let mut p = b.add("tail_0", Some(hips), t(0.0, 0.0, -0.12));
+    for i in 1..8 {
+        p = b.add(format!("tail_{i}"), Some(p), t(0.0, -0.012, -0.075));
+    }
+    for k in 0..8 {
+        let a = k as f32 * TAU / 8.0;
+        let (s, c) = a.sin_cos();
+        let mut p = b.add(
+            format!("skirt_{k}_0"),
+            Some(hips),
+            t(0.17 * s, -0.02, 0.17 * c),
+        );
+        for i in 1..4 {
+            p = b.add(
+                format!("skirt_{k}_{i}"),
+                Some(p),
+                t(0.035 * s, -0.1, 0.035 * c),
+            );
+        }
+    }
+    b.build().expect("the built-in skeleton is valid").0
+}
+
+fn rig() -> RigSettings {
+    let col = |name: &str, bone: &str, offset: Vec3, shape: Shape| ColliderSettings {
+        name: name.into(),
+        bone: bone.into(),
+        offset,
+        rotation: Quat::IDENTITY,
+        shape,
+    };
+    let mut colliders = vec![
+        col(
+            "head",
+            "head",
+            Vec3::new(0.0, 0.09, 0.0),
+            Shape::Sphere {
+                radius: 0.11,
+                inside: false,
+            },
+        ),
+        col(
+            "torso",
+            "spine",
+            Vec3::new(0.0, 0.12, 0.0),
+            Shape::Capsule {
+                radius: 0.12,
+                length: 0.22,
+            },
+        ),
+    ];
+    for side in ["l", "r"] {
+        colliders.push(col(
+            &format!("thigh_{side}"),
+            &format!("thigh_{side}"),
+            Vec3::new(0.0, -0.21, 0.0),
+            Shape::Capsule {
+                radius: 0.075,
+                length: 0.3,
+            },
+        ));
+        colliders.push(col(
+            &format!("shin_{side}"),
+            &format!("shin_{side}"),
+            Vec3::new(0.0, -0.21, 0.0),
+            Shape::Capsule {
+                radius: 0.055,
+                length: 0.32,
+            },
+        ));
+    }
+    let names = |v: &[&str]| v.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+    let base = ChainSettings::default();
+    let mut chains = vec![
+        ChainSettings {
+            name: "ponytail".into(),
+            root: "ponytail_0".into(),
+            damping: 0.08,
+            stiffness: 0.04,
+            radius: 0.025,
+            colliders: names(&["head", "torso"]),
+            curves: crate::dynamics::chain::ChainCurves {
+                stiffness: Curve::new(vec![[0.0, 1.5], [1.0, 0.5]]),
+                ..Default::default()
+            },
+            ..base.clone()
+        },
+        ChainSettings {
+            name: "tail".into(),
+            root: "tail_0".into(),
+            damping: 0.12,
+            stiffness: 0.08,
+            radius: 0.03,
+            limit_angle: 70.0,
+            colliders: names(&["thigh_l", "thigh_r", "shin_l", "shin_r"]),
+            ..base.clone()
+        },
+    ];
+    for side in ["l", "r"] {
+        chains.push(ChainSettings {
+            name: format!("lock_{side}"),
+            root: format!("lock_{side}_0"),
+            damping: 0.15,
+            stiffness: 0.1,
+            radius: 0.015,
+            colliders: names(&["head"]),
+            ..base.clone()
+        });
+        chains.push(ChainSettings {
+            name: format!("chest_{side}"),
+            root: format!("chest_{side}"),
+            damping: 0.2,
+            stiffness: 0.35,
+            dummy_bone_length: 0.06,
+            radius: 0.0,
+            limit_angle: 25.0,
+            gravity: Vec3::new(0.0, -2.0, 0.0),
+            world_damping_location: 0.6,
+            ..base.clone()
+        });
+    }
+    for k in 0..8 {
+        chains.push(ChainSettings {
+            name: format!("skirt_{k}"),
+            root: format!("skirt_{k}_0"),
+            damping: 0.15,
+            stiffness: 0.12,
+            radius: 0.02,
+            world_damping_location: 0.7,
+            colliders: names(&["thigh_l", "thigh_r", "shin_l", "shin_r"]),
+            ..base.clone()
+        });
+    }
+    RigSettings { chains, colliders }
+}
+
+/// Samples a procedural clip at 30 keys per second into LINEAR channels.
+fn bake(
+    sk: &Skeleton,
+    name: &str,
+    duration: f32,
+    pose_at: impl Fn(f32, &mut [Transform], &dyn Fn(&str) -> usize),
+) -> Clip {
+    let find = |n: &str| sk.find(n).expect("built-in bone");
+    let keys = (duration * 30.0).round() as usize;
+    let times: Vec<f32> = (0..=keys)
+        .map(|k| k as f32 * duration / keys as f32)
+        .collect();
+    let mut frames = Vec::new();
+    for &t in &times {
+        let mut locals = sk.rest().to_vec();
+        pose_at(t, &mut locals, &find);
+        frames.push(locals);
+    }
+    let mut tracks = Vec::new();
+    for j in 0..sk.len() {
+        let rot: Vec<Quat> = frames.iter().map(|f| f[j].rotation).collect();
+        let tr: Vec<Vec3> = frames.iter().map(|f| f[j].translation).collect();
+        let moves_r = rot
+            .iter()
+            .any(|q| q.dot(sk.rest()[j].rotation).abs() < 1.0 - 1e-7);
+        let moves_t = tr
+            .iter()
+            .any(|v| !v.abs_diff_eq(sk.rest()[j].translation, 1e-7));
+        if !moves_r && !moves_t {
+            continue;
+        }
+        let ch = |values| Channel {
+            interpolation: Interpolation::Linear,
+            times: times.clone(),
+            values,
+        };
+        tracks.push(JointTrack {
+            joint: j,
+            translation: moves_t.then(|| ch(tr)),
+            rotation: moves_r.then(|| Channel {
+                interpolation: Interpolation::Linear,
+                times: times.clone(),
+                values: rot,
+            }),
+            scale: None,
+        });
+    }
+    Clip {
+        name: name.into(),
+        duration,
+        tracks,
+    }
+}
+
+fn rot(l: &mut [Transform], j: usize, x: f32, y: f32, z: f32) {
+    l[j].rotation = (l[j].rotation * Quat::from_euler(EulerRot::XYZ, x, y, z)).normalize();
+}
+
+/// A gait's shape: leg swing (rad), knee bend (rad), forward lean (rad), vertical bob
+/// (m) and arm swing (rad) over one cycle of `period` seconds.
+struct Gait {
+    period: f32,
+    stride: f32,
+    knee: f32,
+    lean: f32,
+    bob: f32,
+    arm: f32,
+}
+
+impl Gait {
+    fn apply(&self, t: f32, l: &mut [Transform], f: &dyn Fn(&str) -> usize) {
+        let Gait {
+            period,
+            stride,
+            knee,
+            lean,
+            bob,
+            arm,
+        } = *self;
+        let ph = TAU * t / period;
+        let s = ph.sin();
+        rot(l, f("thigh_l"), -stride * s, 0.0, 0.0);
+        rot(l, f("thigh_r"), stride * s, 0.0, 0.0);
+        rot(
+            l,
+            f("shin_l"),
+            knee * (0.5 + 0.5 * (ph + 0.6).cos()).powi(2),
+            0.0,
+            0.0,
+        );
+        rot(
+            l,
+            f("shin_r"),
+            knee * (0.5 - 0.5 * (ph + 0.6).cos()).powi(2),
+            0.0,
+            0.0,
+        );
+        rot(l, f("upper_arm_l"), arm * s, 0.0, 0.0);
+        rot(l, f("upper_arm_r"), -arm * s, 0.0, 0.0);
+        rot(l, f("lower_arm_l"), -arm * 0.8, 0.0, 0.0);
+        rot(l, f("lower_arm_r"), -arm * 0.8, 0.0, 0.0);
+        rot(l, f("spine"), lean, 0.12 * stride * s, 0.0);
+        rot(l, f("hips"), 0.0, -0.15 * stride * s, 0.0);
+        l[f("hips")].translation.y += bob * (2.0 * ph).cos() - bob;
+    }
+}
+
+fn clips(sk: &Skeleton) -> Vec<Clip> {
+    let idle = bake(sk, "idle", 2.0, |t, l, f| {
+        let b = (TAU * t / 2.0).sin();
+        rot(l, f("spine"), 0.02 * b, 0.0, 0.0);
+        rot(l, f("chest"), 0.015 * b, 0.0, 0.0);
+        rot(l, f("head"), -0.03 * b, 0.05 * (TAU * t / 2.0).cos(), 0.0);
+        rot(l, f("upper_arm_l"), 0.0, 0.0, 0.08 + 0.01 * b);
+        rot(l, f("upper_arm_r"), 0.0, 0.0, -0.08 - 0.01 * b);
+    });
+    let walk = bake(sk, "walk", 1.0, |t, l, f| {
+        Gait {
+            period: 1.0,
+            stride: 0.45,
+            knee: 0.7,
+            lean: 0.05,
+            bob: 0.02,
+            arm: 0.35,
+        }
+        .apply(t, l, f)
+    });
+    let run = bake(sk, "run", 0.7, |t, l, f| {
+        Gait {
+            period: 0.7,
+            stride: 0.8,
+            knee: 1.4,
+            lean: 0.25,
+            bob: 0.05,
+            arm: 0.7,
+        }
+        .apply(t, l, f)
+    });
+    let jump = bake(sk, "jump", 1.2, |t, l, f| {
+        // Crouch (0–0.3), extend (0.3–0.45), tuck in the air (0.45–0.9), land (0.9–1.2).
+        let crouch = if t < 0.3 {
+            (t / 0.3 * PI / 2.0).sin()
+        } else if t < 0.45 {
+            1.0 - (t - 0.3) / 0.15
+        } else if t < 0.9 {
+            0.0
+        } else {
+            ((t - 0.9) / 0.3 * PI).sin()
+        };
+        let tuck = if (0.45..0.9).contains(&t) {
+            ((t - 0.45) / 0.45 * PI).sin()
+        } else {
+            0.0
+        };
+        let bend = crouch + 0.8 * tuck;
+        for side in ["l", "r"] {
+            rot(l, f(&format!("thigh_{side}")), -0.9 * bend, 0.0, 0.0);
+            rot(l, f(&format!("shin_{side}")), 1.6 * bend, 0.0, 0.0);
+            rot(l, f(&format!("foot_{side}")), -0.7 * crouch, 0.0, 0.0);
+            let up = if side == "l" { 1.0 } else { -1.0 };
+            rot(
+                l,
+                f(&format!("upper_arm_{side}")),
+                -1.2 * tuck,
+                0.0,
+                up * 0.3 * (1.0 - crouch),
+            );
+        }
+        rot(l, f("spine"), 0.4 * crouch, 0.0, 0.0);
+        l[f("hips")].translation.y -= 0.25 * crouch;
+    });
+    vec![idle, walk, run, jump]
+}
+
+/// A synthetic benchmark character: a root with `chains` chains of `joints` joints each
+/// (0.05 m bones fanning out and down) and `colliders` alternating spheres and capsules
+/// among them.
+pub fn bench_character(chains: usize, joints: usize, colliders: usize) -> (Skeleton, RigSettings) {
+    let mut b = SkeletonBuilder::new();
+    let root = b.add("root", None, Transform::IDENTITY);
+    let mut rig = RigSettings::default();
+    for c in 0..chains {
+        let a = c as f32 * TAU / chains as f32;
+        let dir = Vec3::new(0.3 * a.sin(), -1.0, 0.3 * a.cos()).normalize();
+        let mut p = b.add(
+            format!("c{c}_0"),
+            Some(root),
+            Transform::from_translation(Vec3::new(0.2 * a.sin(), 0.0, 0.2 * a.cos())),
+        );
+        for j in 1..joints {
+            p = b.add(
+                format!("c{c}_{j}"),
+                Some(p),
+                Transform::from_translation(dir * 0.05),
+            );
+        }
+        rig.chains.push(ChainSettings {
+            name: format!("c{c}"),
+            root: format!("c{c}_0"),
+            ..Default::default()
+        });
+    }
+    for k in 0..colliders {
+        let a = (k as f32 + 0.5) * TAU / colliders.max(1) as f32;
+        let offset = Vec3::new(0.3 * a.sin(), -0.2, 0.3 * a.cos());
+        let shape = if k % 2 == 0 {
+            Shape::Sphere {
+                radius: 0.06,
+                inside: false,
+            }
+        } else {
+            Shape::Capsule {
+                radius: 0.04,
+                length: 0.2,
+            }
+        };
+        rig.colliders.push(ColliderSettings {
+            name: format!("k{k}"),
+            bone: "root".into(),
+            offset,
+            rotation: Quat::IDENTITY,
+            shape,
+        });
+    }
+    (b.build().expect("valid bench skeleton").0, rig)
+}
+
+/// Builds the embedded character.
+pub fn character() -> Character {
+    let skeleton = skeleton();
+    let clips = clips(&skeleton);
+    Character {
+        rig: rig(),
+        clips,
+        skeleton,
+    }
+}
+
+/// One moment of the demo script.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DemoMoment {
+    /// The character's world transform.
+    pub component: Transform,
+    /// The clip playing and its local time.
+    pub clip: usize,
+    /// Local time in `clip`.
+    pub clip_time: f32,
+    /// The clip fading out, its local time, and the weight of the new clip (0..1).
+    pub fade_from: Option<(usize, f32, f32)>,
+    /// A label for the phase: idle, walk, run, stop, turn, jump.
+    pub phase: &'static str,
+}
+
+/// The scripted run of `tassel demo`: idle, walk, run, sudden stop, turn in place, jump.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct DemoScript;
+
+const SEGMENTS: [(f32, usize, f32, f32, &str); 7] = [
+    // start, clip, forward speed m/s, yaw rate rad/s, label
+    (0.0, clip::IDLE, 0.0, 0.0, "idle"),
+    (1.5, clip::WALK, 1.4, 0.0, "walk"),
+    (3.5, clip::RUN, 4.0, 0.0, "run"),
+    (6.0, clip::IDLE, 0.0, 0.0, "stop"),
+    (7.0, clip::IDLE, 0.0, PI, "turn"),
+    (8.0, clip::JUMP, 0.0, 0.0, "jump"),
+    (9.2, clip::IDLE, 0.0, 0.0, "idle"),
+];
+const FADE: f32 = 0.2;
+
+impl DemoScript {
+    /// Length of the script, seconds.
+    pub const DURATION: f32 = 10.0;
+
+    /// The state of the script at `t` seconds. Motion is integrated in closed form, so
+    /// any frame rate sees the same path.
+    pub fn at(&self, t: f32) -> DemoMoment {
+        let t = t.clamp(0.0, Self::DURATION);
+        let (mut pos, mut yaw) = (Vec3::ZERO, 0.0f32);
+        let mut seg = 0;
+        for (i, s) in SEGMENTS.iter().enumerate() {
+            let end = SEGMENTS.get(i + 1).map(|n| n.0).unwrap_or(Self::DURATION);
+            if t < s.0 {
+                break;
+            }
+            seg = i;
+            let span = t.min(end) - s.0;
+            // Constant yaw rate and speed within a segment: integrate the heading exactly.
+            if s.3 != 0.0 {
+                let y1 = yaw + s.3 * span;
+                pos += Vec3::new(y1.cos() - yaw.cos(), 0.0, yaw.sin() - y1.sin()) * (-s.2 / s.3);
+                yaw = y1;
+            } else {
+                pos += Quat::from_rotation_y(yaw) * Vec3::Z * (s.2 * span);
+            }
+        }
+        let s = SEGMENTS[seg];
+        let local = t - s.0;
+        if s.1 == clip::JUMP {
+            // Flight from 0.45 s to 0.9 s of the clip: a parabola 0.4 m high.
+            let f = ((local - 0.45) / 0.45).clamp(0.0, 1.0);
+            pos.y = 1.6 * f * (1.0 - f) * 0.4 * 2.5;
+        }
+        let fade_from = (seg > 0 && local < FADE && SEGMENTS[seg - 1].1 != s.1).then(|| {
+            let prev = SEGMENTS[seg - 1];
+            (prev.1, t - prev.0, local / FADE)
+        });
+        DemoMoment {
+            component: Transform::from_translation_rotation(pos, Quat::from_rotation_y(yaw)),
+            clip: s.1,
+            clip_time: local,
+            fade_from,
+            phase: s.4,
+        }
+    }
+
+    /// Writes the animated local pose of moment `m` into `locals` (`scratch` is a second
+    /// buffer of the same size for the cross-fade).
+    pub fn pose(
+        &self,
+        c: &Character,
+        m: &DemoMoment,
+        locals: &mut [Transform],
+        scratch: &mut [Transform],
+    ) {
+        let sample = |clip: usize, t: f32, out: &mut [Transform]| {
+            out.copy_from_slice(c.skeleton.rest());
+            if clip == clip::JUMP {
+                c.clips[clip].sample(t, out);
+            } else {
+                c.clips[clip].sample_looped(t, out);
+            }
+        };
+        sample(m.clip, m.clip_time, locals);
+        if let Some((from, from_t, w)) = m.fade_from {
+            sample(from, from_t, scratch);
+            for (l, old) in locals.iter_mut().zip(scratch.iter()) {
+                *l = old.lerp(l, w);
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::dynamics::chain::ChainRig;
+
+    #[test]
+    fn has_the_promised_parts() {
+        let c = character();
+        let rig = ChainRig::new(&c.skeleton, &c.rig).unwrap();
+        let count = |prefix: &str| {
+            c.skeleton
+                .names()
+                .iter()
+                .filter(|n| n.starts_with(prefix))
+                .count()
+        };
+        assert_eq!(count("ponytail_"), 6);
+        assert_eq!(count("tail_"), 8);
+        assert_eq!(count("skirt_"), 32);
+        assert_eq!(count("lock_"), 6);
+        assert_eq!(count("chest_"), 2);
+        assert_eq!(c.clips.len(), 4);
+        assert!(rig.chain_count() >= 14);
+        for clip in &c.clips {
+            clip.validate(c.skeleton.len()).unwrap();
+        }
+    }
+
+    #[test]
+    fn script_turns_half_a_circle_and_stops() {
+        let s = DemoScript;
+        let before = s.at(6.5).component;
+        let after = s.at(8.0).component;
+        // The turn is in place: no translation, 180° of yaw.
+        assert!(before.translation.abs_diff_eq(after.translation, 1e-4));
+        let fwd = after.rotation * Vec3::Z;
+        assert!(fwd.abs_diff_eq(-Vec3::Z, 1e-4), "{fwd}");
+        // Walked 2 s at 1.4 m/s then ran 2.5 s at 4 m/s.
+        assert!((before.translation.z - (2.8 + 10.0)).abs() < 1e-3);
+    }
+}

@@ -19,12 +19,14 @@ pub mod builtin;
 pub mod collide;
 pub mod dynamics;
 mod error;
+mod instance;
 pub mod math;
 mod pose;
 pub mod rng;
 mod skeleton;
 
 pub use error::{Error, Result};
+pub use instance::CharacterSim;
 pub use math::Transform;
 pub use pose::{LocalToModelJob, ModelToLocalJob, Pose};
 pub use skeleton::{Skeleton, SkeletonBuilder, MAX_JOINTS, NO_PARENT};

@@ -90,6 +90,17 @@ impl PlacedCollider {
     /// into keep-inside spheres, above planes.
     pub fn resolve(&self, p: Vec3, prev: Vec3, r: f32) -> Vec3 {
         let t = &self.transform;
+        // Cheap reject: both ends of the step far from a bounded shape.
+        if let Some(bound) = self.bounding_radius() {
+            let reach = bound + r;
+            let c = t.translation;
+            if (p - c).length_squared() > reach * reach
+                && (prev - c).length_squared() > reach * reach
+                && (p - prev).length_squared() < ((p - c).length() - reach).powi(2)
+            {
+                return p;
+            }
+        }
         match self.shape {
             Shape::Sphere {
                 radius,
@@ -121,6 +132,20 @@ impl PlacedCollider {
             }
             Shape::Box { half_extents } => box_penetration(p, t, half_extents, r),
             Shape::Plane => plane_penetration(p, t.translation, t.rotation * Vec3::Y, r),
+        }
+    }
+
+    /// Radius of a sphere about the origin that holds the shape (`None` for planes and
+    /// inside limits, which act everywhere).
+    fn bounding_radius(&self) -> Option<f32> {
+        match self.shape {
+            Shape::Sphere {
+                radius,
+                inside: false,
+            } => Some(radius),
+            Shape::Capsule { radius, length } => Some(radius + 0.5 * length),
+            Shape::Box { half_extents } => Some(half_extents.length()),
+            _ => None,
         }
     }
 

@@ -265,6 +265,18 @@ impl ChainRig {
         }
     }
 
+    /// The joints that turn toward simulated children, in joint order, each with the point
+    /// it sits on and its first child point (its "tail").
+    pub fn rotating_joints(&self) -> impl Iterator<Item = (usize, usize, usize)> + '_ {
+        self.rotators.iter().map(|(j, p, kids)| {
+            (
+                *j as usize,
+                *p as usize,
+                self.rotator_children[kids.start as usize] as usize,
+            )
+        })
+    }
+
     /// The collision radius of point `p`.
     pub fn point_radius(&self, p: usize) -> f32 {
         self.radius[p]

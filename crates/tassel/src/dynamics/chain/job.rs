@@ -414,14 +414,18 @@ fn run_chain(rig: &ChainRig, ci: usize, state: &mut ChainState, component: &Tran
             // The interpolated output also respects this frame's colliders.
             let mut x = restore(t + dev);
             let r = rig.radius[p];
-            for _ in 0..2 {
+            let collide = |mut x: Vec3| {
                 for &c in &rig.chains[ci].colliders {
                     x = state.colliders[c].resolve(x, x, r);
                 }
-                x = restore(x);
-            }
-            for &c in &rig.chains[ci].colliders {
-                x = state.colliders[c].resolve(x, x, r);
+                x
+            };
+            for pass in 0..3 {
+                let y = collide(x);
+                if y == x {
+                    break;
+                }
+                x = if pass < 2 { restore(y) } else { y };
             }
             x
         };

@@ -120,10 +120,18 @@ pub(crate) fn step_chain(
         let restore = |x: Vec3| pos[pp] + normalize_or(x - pos[pp], fallback) * length;
         x = restore(x);
         if !chain.colliders.is_empty() {
+            let mut settled = false;
             for _ in 0..3 {
-                x = restore(collide(x));
+                let y = collide(x);
+                if y == x {
+                    settled = true;
+                    break;
+                }
+                x = restore(y);
             }
-            x = collide(x);
+            if !settled {
+                x = collide(x);
+            }
         }
         pos[p] = x;
     }

@@ -1,0 +1,236 @@
+//! `tassel demo`: the embedded character through the scripted sequence.
+
+use crate::output::write_atomic;
+use crate::picture::{draw, Panel, Series};
+use glam::{Quat, Vec3};
+use std::path::PathBuf;
+use std::time::Instant;
+use tassel::builtin::{self, DemoScript};
+use tassel::collide::Shape;
+use tassel::CharacterSim;
+use tassel_gltf::{export_glb, BakedClip, BakedTrack, BoneMesh, ExportSource};
+
+/// Options of `tassel demo`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// Folder for demo.glb and demo.png.
+    #[arg(long, default_value = ".")]
+    out: PathBuf,
+    /// Frames per second.
+    #[arg(long, default_value_t = 60.0)]
+    fps: f32,
+}
+
+const MOMENTS: [f32; 6] = [1.0, 3.0, 5.0, 6.15, 7.5, 8.7];
+
+fn chain_color(name: &str) -> [u8; 3] {
+    match name.split('_').next().unwrap_or("") {
+        "ponytail" => [235, 120, 20],
+        "lock" => [210, 170, 0],
+        "tail" => [40, 90, 220],
+        "skirt" => [200, 40, 160],
+        "chest" => [220, 30, 30],
+        _ => [0, 0, 0],
+    }
+}
+
+pub fn run(a: Args) -> Result<(), String> {
+    if !(a.fps.is_finite() && (1.0..=1000.0).contains(&a.fps)) {
+        return Err(format!("--fps {} must be 1..=1000", a.fps));
+    }
+    std::fs::create_dir_all(&a.out).map_err(|e| format!("{}: {e}", a.out.display()))?;
+    let c = builtin::character();
+    let sk = &c.skeleton;
+    let mut sim = CharacterSim::new(sk.clone(), &c.rig).map_err(|e| e.to_string())?;
+    let script = DemoScript;
+    let dt = 1.0 / a.fps;
+    let frames = (DemoScript::DURATION * a.fps).round() as usize;
+    let mut locals = sk.rest().to_vec();
+    let mut scratch = locals.clone();
+    let n = sk.len();
+    let mut rot_keys: Vec<Vec<Quat>> = vec![Vec::with_capacity(frames + 1); n];
+    let mut tr_keys: Vec<Vec<Vec3>> = vec![Vec::with_capacity(frames + 1); n];
+    let mut times = Vec::with_capacity(frames + 1);
+    // Chain membership per joint, for colours.
+    let mut chain_of: Vec<Option<usize>> = vec![None; n];
+    for p in 0..sim.chains().point_count() {
+        let info = sim.chains().point(p);
+        if let (Some(j), Some(_)) = (info.joint, info.parent) {
+            chain_of[j] = Some(info.chain);
+        }
+    }
+    let tracked = ["ponytail", "tail", "skirt_0", "lock_l"];
+    let tips: Vec<usize> = tracked
+        .iter()
+        .map(|name| {
+            let ci = (0..sim.chains().chain_count())
+                .find(|&i| sim.chains().chain_settings(i).name == *name)
+                .unwrap_or(0);
+            sim.chains().chain_points(ci).end - 1
+        })
+        .collect();
+    let mut deviation: Vec<Vec<f32>> = vec![Vec::new(); tips.len()];
+    let mut panels = Vec::new();
+    let mut next_moment = 0;
+    let mut sim_time = 0.0f64;
+    for f in 0..=frames {
+        let t = f as f32 * dt;
+        let m = script.at(t);
+        script.pose(&c, &m, &mut locals, &mut scratch);
+        let start = Instant::now();
+        sim.frame(&locals, m.component, if f == 0 { 0.0 } else { dt })
+            .map_err(|e| e.to_string())?;
+        let pose = sim.pose();
+        sim_time += start.elapsed().as_secs_f64();
+        times.push(t);
+        for j in 0..n {
+            let mut l = pose.locals[j];
+            if sk.parent(j).is_none() {
+                l = m.component * l;
+            }
+            rot_keys[j].push(l.rotation);
+            tr_keys[j].push(l.translation);
+        }
+        let out = sim.state().output_positions();
+        let targets = sim.state().target_positions();
+        for (k, &tip) in tips.iter().enumerate() {
+            deviation[k].push((out[tip] - targets[tip]).length());
+        }
+        if next_moment < MOMENTS.len() && t + 0.5 * dt >= MOMENTS[next_moment] {
+            next_moment += 1;
+            // Side view in the character's own (model) space, lifted by its world height so
+            // that jumps show.
+            let lift = Vec3::new(0.0, m.component.translation.y, 0.0);
+            let view = |p: Vec3| p + lift;
+            let mut segments = Vec::new();
+            let anim = sim.animated_models();
+            for j in 0..n {
+                if let (Some(p), Some(_)) = (sk.parent(j), chain_of[j]) {
+                    segments.push((
+                        view(anim[p].translation),
+                        view(anim[j].translation),
+                        [200, 205, 215],
+                        2.0,
+                    ));
+                }
+            }
+            for j in 0..n {
+                let Some(p) = sk.parent(j) else { continue };
+                let (col, w) = match chain_of[j] {
+                    Some(ci) => (chain_color(&sim.chains().chain_settings(ci).name), 3.0),
+                    None => ([70, 70, 70], 2.5),
+                };
+                segments.push((
+                    view(pose.models[p].translation),
+                    view(pose.models[j].translation),
+                    col,
+                    w,
+                ));
+            }
+            for p in 0..sim.chains().point_count() {
+                let info = sim.chains().point(p);
+                if let (None, Some(parent)) = (info.joint, info.parent) {
+                    let col = chain_color(&sim.chains().chain_settings(info.chain).name);
+                    segments.push((view(out[parent]), view(out[p]), col, 3.0));
+                }
+            }
+            let mut circles = Vec::new();
+            for col in sim.state().placed_colliders() {
+                let centre = view(col.transform.translation);
+                match col.shape {
+                    Shape::Sphere { radius, .. } => circles.push((centre, radius)),
+                    Shape::Capsule { radius, length } => {
+                        let axis = col.transform.rotation * Vec3::Y * (0.5 * length);
+                        circles.push((centre - axis, radius));
+                        circles.push((centre + axis, radius));
+                        let side = Vec3::new(0.0, -axis.z, axis.y).normalize_or_zero() * radius;
+                        segments.push((
+                            centre - axis + side,
+                            centre + axis + side,
+                            [150, 200, 150],
+                            1.2,
+                        ));
+                        segments.push((
+                            centre - axis - side,
+                            centre + axis - side,
+                            [150, 200, 150],
+                            1.2,
+                        ));
+                    }
+                    _ => {}
+                }
+            }
+            panels.push(Panel { segments, circles });
+        }
+    }
+    // Baked animation: rotations of every joint, translations of those that move.
+    let mut tracks = Vec::new();
+    for j in 0..n {
+        let moves = tr_keys[j]
+            .iter()
+            .any(|v| !v.abs_diff_eq(sk.rest()[j].translation, 1e-6));
+        tracks.push(BakedTrack {
+            node: j,
+            translations: moves.then(|| tr_keys[j].clone()),
+            rotations: Some(rot_keys[j].clone()),
+            scales: None,
+        });
+    }
+    let source = ExportSource::from_skeleton(sk, BoneMesh::Octahedra);
+    let glb = export_glb(
+        &source,
+        &[BakedClip {
+            name: "demo".into(),
+            times,
+            tracks,
+        }],
+    )
+    .map_err(|e| e.to_string())?;
+    let bands = [
+        (0.0, [236, 236, 236]),
+        (1.5, [226, 238, 226]),
+        (3.5, [246, 228, 222]),
+        (6.0, [236, 236, 236]),
+        (7.0, [226, 232, 246]),
+        (8.0, [246, 240, 214]),
+        (9.2, [236, 236, 236]),
+    ];
+    let series: Vec<Series> = tracked
+        .iter()
+        .zip(deviation)
+        .map(|(name, values)| Series {
+            color: chain_color(name),
+            values,
+        })
+        .collect();
+    let png = draw(&panels, &bands, &series, DemoScript::DURATION).png()?;
+    let glb_path = a.out.join("demo.glb");
+    let png_path = a.out.join("demo.png");
+    write_atomic(&glb_path, &glb)?;
+    write_atomic(&png_path, &png)?;
+    let simulated = sim.chains().point_count() - sim.chains().chain_count();
+    println!(
+        "tassel demo: idle, walk, run, sudden stop, turn in place, jump ({:.0} s at {} Hz)",
+        DemoScript::DURATION,
+        a.fps
+    );
+    println!("  frames: {}", frames + 1);
+    println!(
+        "  chains: {}, joints simulated: {simulated} (of {n}), colliders: {}",
+        sim.chains().chain_count(),
+        sim.chains().collider_count()
+    );
+    println!(
+        "  time per frame (secondary motion incl. pose jobs): {:.1} us",
+        sim_time * 1e6 / (frames + 1) as f64
+    );
+    println!("  teleport resets: {}", sim.state().teleport_count());
+    println!(
+        "  wrote {} ({} bytes) and {} ({} bytes)",
+        glb_path.display(),
+        glb.len(),
+        png_path.display(),
+        png.len()
+    );
+    Ok(())
+}

@@ -1,0 +1,263 @@
+//! The `tassel` binary end to end: demo output validity and determinism, the simulate
+//! contract, and bad input (clear error, non-zero exit, no output file).
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn tassel() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_tassel"))
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("tassel-cli-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn testdata(rel: &str) -> Option<PathBuf> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/testdata");
+    if root.is_dir() {
+        return Some(root.join(rel));
+    }
+    if std::env::var_os("TASSEL_REQUIRE_TESTDATA").is_some() {
+        panic!("../shared/testdata is missing (TASSEL_REQUIRE_TESTDATA is set)");
+    }
+    eprintln!("SKIPPED: ../shared/testdata is missing; {rel} not tested");
+    None
+}
+
+fn validate(file: &Path) -> Option<String> {
+    let tools = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tools");
+    if !tools.join("node_modules/gltf-validator").is_dir() {
+        if std::env::var_os("TASSEL_REQUIRE_VALIDATOR").is_some() {
+            panic!("gltf-validator is not installed: run `npm ci` in tools/");
+        }
+        eprintln!(
+            "SKIPPED: gltf-validator not installed; {} not validated",
+            file.display()
+        );
+        return None;
+    }
+    let out = Command::new("node")
+        .arg(tools.join("validate.mjs"))
+        .arg(file)
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout).to_string();
+    assert!(
+        out.status.success(),
+        "validator found errors in {}: {text}",
+        file.display()
+    );
+    Some(text)
+}
+
+#[test]
+fn demo_writes_valid_files_and_is_deterministic() {
+    let (a, b) = (tmp("demo-a"), tmp("demo-b"));
+    for d in [&a, &b] {
+        let out = tassel().args(["demo", "--out"]).arg(d).output().unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert!(text.contains("joints simulated"), "{text}");
+    }
+    let glb = std::fs::read(a.join("demo.glb")).unwrap();
+    assert_eq!(
+        glb,
+        std::fs::read(b.join("demo.glb")).unwrap(),
+        "demo.glb differs between runs"
+    );
+    assert_eq!(
+        std::fs::read(a.join("demo.png")).unwrap(),
+        std::fs::read(b.join("demo.png")).unwrap()
+    );
+    assert_eq!(&std::fs::read(a.join("demo.png")).unwrap()[1..4], b"PNG");
+    if let Some(report) = validate(&a.join("demo.glb")) {
+        assert!(report.contains("\"errors\":0"), "{report}");
+    }
+    // The baked clip has one key per frame: 10 s at 60 Hz = 601 keys.
+    let json_len = u32::from_le_bytes(glb[12..16].try_into().unwrap()) as usize;
+    let doc: serde_json::Value = serde_json::from_slice(&glb[20..20 + json_len]).unwrap();
+    let input = doc["animations"][0]["samplers"][0]["input"]
+        .as_u64()
+        .unwrap() as usize;
+    assert_eq!(doc["accessors"][input]["count"], 601);
+    assert!((doc["accessors"][input]["max"][0].as_f64().unwrap() - 10.0).abs() < 1e-4);
+}
+
+fn simulate(args: &[&str], out: &Path) -> std::process::Output {
+    tassel()
+        .arg("simulate")
+        .args(args)
+        .arg("--out")
+        .arg(out)
+        .output()
+        .unwrap()
+}
+
+#[test]
+fn simulate_builtin_follows_the_contract() {
+    let d = tmp("sim");
+    let out_file = d.join("s.json");
+    let out = simulate(
+        &[
+            "--builtin",
+            "--motion",
+            "sin",
+            "--frames",
+            "30",
+            "--mode",
+            "fixed",
+        ],
+        &out_file,
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let doc: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(&out_file).unwrap()).unwrap();
+    assert_eq!(doc["frames"], 30);
+    assert_eq!(doc["mode"], "fixed");
+    let samples = doc["samples"].as_array().unwrap();
+    assert_eq!(samples.len(), 30);
+    let joints = doc["joints"].as_array().unwrap();
+    assert!(joints.iter().any(|j| j["name"] == "ponytail_0"));
+    // root_pos follows amp·sin(2π·freq·t) on x, computed here by hand.
+    for s in samples {
+        let t = s["t"].as_f64().unwrap();
+        let x = s["root_pos"][0].as_f64().unwrap();
+        assert!((x - 0.5 * (std::f64::consts::TAU * t).sin()).abs() < 1e-5);
+        assert_eq!(s["world_pos"].as_array().unwrap().len(), joints.len());
+    }
+    // Bone length joint → tail equals the rest length at every frame.
+    let len = |a: &serde_json::Value, b: &serde_json::Value| -> f64 {
+        (0..3)
+            .map(|k| (a[k].as_f64().unwrap() - b[k].as_f64().unwrap()).powi(2))
+            .sum::<f64>()
+            .sqrt()
+    };
+    for (i, _) in joints.iter().enumerate() {
+        let rest = len(
+            &doc["initial"]["world_pos"][i],
+            &doc["initial"]["tail_world_pos"][i],
+        );
+        for s in samples {
+            let l = len(&s["world_pos"][i], &s["tail_world_pos"][i]);
+            assert!((l - rest).abs() < 1e-4, "joint {i}: {l} vs {rest}");
+        }
+    }
+}
+
+#[test]
+fn simulate_gltf_with_rig() {
+    let Some(fox) = testdata("gltf/Fox.glb") else {
+        return;
+    };
+    let d = tmp("fox");
+    let rig = d.join("fox.toml");
+    std::fs::write(&rig, "[[chain]]\nname = \"tail\"\nroot = \"b_Tail01_012\"\nradius = 1.0\ngravity = [0.0, -981.0, 0.0]\nteleport_distance = 0.0\n").unwrap();
+    let out_file = d.join("fox.json");
+    let out = simulate(
+        &[
+            fox.to_str().unwrap(),
+            "--rig",
+            rig.to_str().unwrap(),
+            "--motion",
+            "sin",
+            "--amp",
+            "30",
+        ],
+        &out_file,
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let doc: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(&out_file).unwrap()).unwrap();
+    let names: Vec<&str> = doc["joints"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|j| j["name"].as_str().unwrap())
+        .collect();
+    assert!(names.contains(&"b_Tail01_012"), "{names:?}");
+    // The tail swings: its tip leaves the rigidly carried rest position.
+    let s = &doc["samples"][59];
+    let last = names.len() - 1;
+    let tip_x = s["tail_world_pos"][last][0].as_f64().unwrap();
+    let rigid_x = doc["initial"]["tail_world_pos"][last][0].as_f64().unwrap()
+        + s["root_pos"][0].as_f64().unwrap();
+    assert!(
+        (tip_x - rigid_x).abs() > 0.1,
+        "tail did not swing: {tip_x} vs {rigid_x}"
+    );
+}
+
+fn assert_fails(args: &[&str], out: &Path, needle: &str) {
+    let o = simulate(args, out);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success(), "{args:?} succeeded");
+    assert!(
+        err.contains(needle),
+        "{args:?}: error '{err}' does not mention '{needle}'"
+    );
+    assert!(!out.exists(), "{args:?} left {}", out.display());
+}
+
+#[test]
+fn bad_input_fails_cleanly() {
+    let d = tmp("bad");
+    let out = d.join("never.json");
+    let rig = |name: &str, text: &str| {
+        let p = d.join(name);
+        std::fs::write(&p, text).unwrap();
+        p.to_str().unwrap().to_string()
+    };
+    let missing = rig(
+        "missing.toml",
+        "[[chain]]\nname = \"x\"\nroot = \"no_such_bone\"\n",
+    );
+    assert_fails(&["--builtin", "--rig", &missing], &out, "no_such_bone");
+    let negative = rig(
+        "neg.toml",
+        "[[chain]]\nname = \"p\"\nroot = \"ponytail_0\"\n[[collider]]\nname = \"h\"\nbone = \"head\"\nshape = \"sphere\"\nradius = -0.1\n",
+    );
+    assert_fails(&["--builtin", "--rig", &negative], &out, "radius");
+    let nan = rig(
+        "nan.toml",
+        "[[chain]]\nname = \"p\"\nroot = \"ponytail_0\"\nstiffness = nan\n",
+    );
+    assert_fails(&["--builtin", "--rig", &nan], &out, "stiffness");
+    assert_fails(&["--builtin", "--dt", "1000"], &out, "--dt");
+    assert_fails(&["--builtin", "--dt", "NaN"], &out, "--dt");
+    if let Some(fox) = testdata("gltf/Fox.glb") {
+        let bytes = std::fs::read(fox).unwrap();
+        let cut = d.join("cut.glb");
+        std::fs::write(&cut, &bytes[..bytes.len() / 3]).unwrap();
+        let ok_rig = rig(
+            "ok.toml",
+            "[[chain]]\nname = \"t\"\nroot = \"b_Tail01_012\"\n",
+        );
+        assert_fails(&[cut.to_str().unwrap(), "--rig", &ok_rig], &out, "cut.glb");
+    }
+    let cycle = d.join("cycle.gltf");
+    std::fs::write(&cycle, r#"{"asset":{"version":"2.0"},"nodes":[{"name":"a","children":[1]},{"name":"b","children":[0]}],"skins":[{"joints":[0,1]}]}"#).unwrap();
+    let r = rig("ab.toml", "[[chain]]\nname = \"t\"\nroot = \"a\"\n");
+    assert_fails(&[cycle.to_str().unwrap(), "--rig", &r], &out, "cycle");
+    // An output folder that does not exist: error, nothing written.
+    let o = tassel()
+        .args(["simulate", "--builtin", "--out", "/no/such/dir/x.json"])
+        .output()
+        .unwrap();
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("/no/such/dir"));
+}

@@ -1,0 +1,111 @@
+//! One character's secondary-motion frame, wiring skeleton, chain rig and state together.
+
+use crate::dynamics::chain::{ChainJob, ChainRig, ChainState};
+use crate::dynamics::RigSettings;
+use crate::error::{Error, Result};
+use crate::math::Transform;
+use crate::pose::{LocalToModelJob, Pose};
+use crate::skeleton::Skeleton;
+
+/// A character ready to simulate: its skeleton, compiled rig, state and last pose.
+///
+/// ```
+/// use tassel::{builtin, CharacterSim, Transform};
+/// let c = builtin::character();
+/// let mut sim = CharacterSim::new(c.skeleton.clone(), &c.rig).unwrap();
+/// let rest = c.skeleton.rest().to_vec();
+/// let pose = sim.frame(&rest, Transform::IDENTITY, 1.0 / 60.0).unwrap();
+/// assert_eq!(pose.locals.len(), c.skeleton.len());
+/// ```
+#[derive(Debug, Clone)]
+pub struct CharacterSim {
+    skeleton: Skeleton,
+    rig: ChainRig,
+    state: ChainState,
+    pose: Pose,
+    animated_models: Vec<Transform>,
+}
+
+impl CharacterSim {
+    /// Compiles `rig` for `skeleton`.
+    pub fn new(skeleton: Skeleton, rig: &RigSettings) -> Result<Self> {
+        let chains = ChainRig::new(&skeleton, rig)?;
+        let state = ChainState::new(&chains);
+        let pose = Pose::rest(&skeleton);
+        let animated_models = pose.models.clone();
+        Ok(Self {
+            skeleton,
+            rig: chains,
+            state,
+            pose,
+            animated_models,
+        })
+    }
+
+    /// Runs one frame: `animated` local pose, the character's world transform, frame time.
+    /// Returns the pose with simulated rotations (model space = character space).
+    pub fn frame(
+        &mut self,
+        animated: &[Transform],
+        component: Transform,
+        dt: f32,
+    ) -> Result<&Pose> {
+        if animated.len() != self.skeleton.len() {
+            return Err(Error::LengthMismatch {
+                what: "animated pose",
+                expected: self.skeleton.len(),
+                got: animated.len(),
+            });
+        }
+        self.pose.locals.copy_from_slice(animated);
+        LocalToModelJob {
+            skeleton: &self.skeleton,
+            root: Transform::IDENTITY,
+            locals: &self.pose.locals,
+            models: &mut self.pose.models,
+        }
+        .run()?;
+        self.animated_models.copy_from_slice(&self.pose.models);
+        ChainJob {
+            skeleton: &self.skeleton,
+            rig: &self.rig,
+            state: &mut self.state,
+            component,
+            dt,
+            locals: &mut self.pose.locals,
+            models: &mut self.pose.models,
+        }
+        .run()?;
+        Ok(&self.pose)
+    }
+
+    /// The skeleton.
+    pub fn skeleton(&self) -> &Skeleton {
+        &self.skeleton
+    }
+
+    /// The compiled chains.
+    pub fn chains(&self) -> &ChainRig {
+        &self.rig
+    }
+
+    /// The chain state (output positions, placed colliders...).
+    pub fn state(&self) -> &ChainState {
+        &self.state
+    }
+
+    /// The last output pose.
+    pub fn pose(&self) -> &Pose {
+        &self.pose
+    }
+
+    /// The last animated (input) model pose.
+    pub fn animated_models(&self) -> &[Transform] {
+        &self.animated_models
+    }
+
+    /// Starts the chains again from the animated pose on the next frame.
+    pub fn reset(&mut self) {
+        self.state.reset();
+    }
+}
