@@ -515,7 +515,7 @@ impl DemoScript {
         if s.1 == clip::JUMP {
             // Flight from 0.45 s to 0.9 s of the clip: a parabola 0.4 m high.
             let f = ((local - 0.45) / 0.45).clamp(0.0, 1.0);
-            pos.y = 1.6 * f * (1.0 - f) * 0.4 * 2.5;
+            pos.y = 4.0 * 0.4 * f * (1.0 - f);
         }
         let fade_from = (seg > 0 && local < FADE && SEGMENTS[seg - 1].1 != s.1).then(|| {
             let prev = SEGMENTS[seg - 1];

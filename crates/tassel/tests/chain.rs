@@ -414,3 +414,86 @@ fn same_inputs_same_bits() {
     };
     assert_eq!(run(), run());
 }
+
+#[test]
+fn wind_pushes_the_chain_downwind() {
+    let sk = line_skeleton(4, 0.1, -Vec3::Y);
+    let mut s = free(TimeMode::Fixed, 60.0);
+    s.damping = 0.2;
+    s.gravity = Vec3::ZERO;
+    s.wind.direction = Vec3::Z;
+    s.wind.speed = 0.002;
+    let mut sim = Sim::new(
+        sk,
+        RigSettings {
+            chains: vec![s],
+            colliders: vec![],
+        },
+    );
+    let mut pts = Vec::new();
+    for _ in 0..300 {
+        pts = sim.frame(Transform::IDENTITY, 1.0 / 60.0);
+    }
+    // Without gravity or stiffness the steady wind lays the chain along +Z.
+    let dir = (pts[4] - pts[0]).normalize();
+    assert!(dir.z > 0.9, "chain direction {dir}");
+}
+
+#[test]
+fn alpha_warmup_and_turn_teleport() {
+    // alpha 0: the animated pose, whatever the dynamics.
+    let sk = line_skeleton(4, 0.1, Vec3::X);
+    let mut s = free(TimeMode::Fixed, 60.0);
+    s.alpha = 0.0;
+    let mut sim = Sim::new(
+        sk.clone(),
+        RigSettings {
+            chains: vec![s],
+            colliders: vec![],
+        },
+    );
+    let rest = Pose::rest(&sk);
+    for _ in 0..30 {
+        let pts = sim.frame(Transform::IDENTITY, 1.0 / 60.0);
+        for (i, p) in pts.iter().enumerate() {
+            assert!(p.abs_diff_eq(rest.models[i].translation, 1e-5));
+        }
+    }
+    // Warm-up: 600 steps on the first frame let a horizontal chain fall to hang already.
+    let mut s = free(TimeMode::Fixed, 60.0);
+    s.damping = 0.1;
+    s.warmup_steps = 600;
+    let mut sim = Sim::new(
+        sk.clone(),
+        RigSettings {
+            chains: vec![s],
+            colliders: vec![],
+        },
+    );
+    let pts = sim.frame(Transform::IDENTITY, 0.0);
+    assert!(
+        (pts[4] - pts[0]).normalize().dot(-Vec3::Y) > 0.99,
+        "{}",
+        pts[4]
+    );
+    // Turning 90° in one frame (threshold 60°) resets to the animated pose.
+    let mut sim = Sim::new(
+        sk.clone(),
+        RigSettings {
+            chains: vec![free(TimeMode::Fixed, 60.0)],
+            colliders: vec![],
+        },
+    );
+    for _ in 0..20 {
+        sim.frame(Transform::IDENTITY, 1.0 / 60.0);
+    }
+    let turned = Transform::from_translation_rotation(
+        Vec3::ZERO,
+        Quat::from_rotation_y(std::f32::consts::FRAC_PI_2),
+    );
+    let pts = sim.frame(turned, 1.0 / 60.0);
+    assert_eq!(sim.state.teleport_count(), 1);
+    for (i, p) in pts.iter().enumerate() {
+        assert!(p.abs_diff_eq(turned.transform_point(rest.models[i].translation), 1e-5));
+    }
+}

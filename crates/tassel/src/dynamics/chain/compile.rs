@@ -48,6 +48,7 @@ pub struct ChainRig {
     // Per point (structure of arrays), chains one after another, parents before children.
     pub(crate) joint: Vec<u16>,
     pub(crate) parent: Vec<u32>,
+    pub(crate) chain_of: Vec<u16>,
     pub(crate) dummy_length: Vec<f32>,
     pub(crate) damping: Vec<f32>,
     pub(crate) stiffness: Vec<f32>,
@@ -72,6 +73,7 @@ impl ChainRig {
             colliders: Vec::new(),
             joint: Vec::new(),
             parent: Vec::new(),
+            chain_of: Vec::new(),
             dummy_length: Vec::new(),
             damping: Vec::new(),
             stiffness: Vec::new(),
@@ -164,6 +166,7 @@ impl ChainRig {
                 }
             }
             let end = out.joint.len();
+            out.chain_of.resize(end, ci as u16);
             let max_dist = rest_dist.iter().cloned().fold(0.0f32, f32::max).max(1e-6);
             let curves = &settings.curves;
             for &d in &rest_dist {

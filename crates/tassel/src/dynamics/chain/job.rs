@@ -245,10 +245,9 @@ fn gather_targets(
         };
         if parent != NONE {
             let pj = rig.joint[parent as usize] as usize;
-            let chain = rig.chains.iter().find(|c| c.points.contains(&p));
-            let axis = chain
-                .map(|c| c.settings.planar_constraint)
-                .unwrap_or(PlanarAxis::None);
+            let axis = rig.chains[rig.chain_of[p] as usize]
+                .settings
+                .planar_constraint;
             let local_axis = match axis {
                 PlanarAxis::X => Vec3::X,
                 PlanarAxis::Z => Vec3::Z,
