@@ -96,15 +96,32 @@ impl<T: Animatable> Channel<T> {
 
     /// The value at time `t` (clamped to the first and last keys).
     pub fn sample(&self, t: f32) -> T {
+        let mut hint = 0;
+        self.sample_with_hint(t, &mut hint)
+    }
+
+    /// Like [`Channel::sample`], starting the key search at `*hint` (the key found last
+    /// time) and updating it: forward playback walks at most a key or two, no search.
+    pub fn sample_with_hint(&self, t: f32, hint: &mut u32) -> T {
         let n = self.times.len();
         if n == 1 || t <= self.times[0] {
+            *hint = 0;
             return self.value(0).finish();
         }
         if t >= self.times[n - 1] {
+            *hint = (n - 1) as u32;
             return self.value(n - 1).finish();
         }
-        // Last key at or before t.
-        let k = self.times.partition_point(|&x| x <= t) - 1;
+        // Last key at or before t: walk forward from the hint, search when going back.
+        let mut k = (*hint as usize).min(n - 2);
+        if self.times[k] > t {
+            k = self.times.partition_point(|&x| x <= t) - 1;
+        } else {
+            while self.times[k + 1] <= t {
+                k += 1;
+            }
+        }
+        *hint = k as u32;
         let (t0, t1) = (self.times[k], self.times[k + 1]);
         let td = t1 - t0;
         let s = if td > 0.0 { (t - t0) / td } else { 0.0 };

@@ -3,6 +3,8 @@
 
 mod blend;
 mod clip;
+mod sample;
 
-pub use blend::blend_locals;
+pub use blend::{blend_locals, make_additive, BlendJob, BlendLayer, JointAccumulator};
 pub use clip::{Channel, Clip, Interpolation, JointTrack};
+pub use sample::{Playback, SamplingCursor, SamplingJob};
