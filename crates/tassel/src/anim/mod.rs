@@ -2,9 +2,13 @@
 //! rules (STEP, LINEAR, CUBICSPLINE), and simple pose blending.
 
 mod blend;
+mod blend_space;
 mod clip;
 mod sample;
+mod state_machine;
 
 pub use blend::{blend_locals, make_additive, BlendJob, BlendLayer, JointAccumulator};
+pub use blend_space::{BlendSpace1D, BlendSpacePhase};
 pub use clip::{Channel, Clip, Interpolation, JointTrack};
 pub use sample::{Playback, SamplingCursor, SamplingJob};
+pub use state_machine::{BlendPlan, ParamKind, PlanLayer, StateMachine, StateMachineState};
