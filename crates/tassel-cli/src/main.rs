@@ -1,10 +1,11 @@
-//! The `tassel` command: `demo`, `simulate`, `bench`. Argument parsing, files and printing
+//! The `tassel` command: `demo`, `simulate`, `sample`, `bench`. Argument parsing, files and printing
 //! only; the work is in the `tassel` and `tassel-gltf` crates.
 
 mod bench;
 mod demo;
 mod output;
 mod picture;
+mod sample;
 mod simulate;
 
 use clap::{Parser, Subcommand};
@@ -28,6 +29,8 @@ enum Command {
     Demo(demo::Args),
     /// A scripted, machine-readable run: joint positions per frame as JSON.
     Simulate(simulate::Args),
+    /// Sampled (and blended) local and world transforms of every node of a file, as JSON.
+    Sample(sample::Args),
     /// Measure ns per joint-step for 16 chains × 8 joints with 8 colliders.
     Bench(bench::Args),
 }
@@ -38,6 +41,7 @@ fn main() -> ExitCode {
         Command::Demo(a) => demo::run(a),
         Command::Simulate(a) => simulate::run(a),
         Command::Bench(a) => bench::run(a),
+        Command::Sample(a) => sample::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

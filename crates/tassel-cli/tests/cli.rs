@@ -261,3 +261,71 @@ fn bad_input_fails_cleanly() {
     assert!(!o.status.success());
     assert!(String::from_utf8_lossy(&o.stderr).contains("/no/such/dir"));
 }
+
+#[test]
+fn sample_prints_hand_checkable_values() {
+    let Some(fox) = testdata("gltf/Fox.glb") else {
+        return;
+    };
+    let d = tmp("sample");
+    let out_file = d.join("s.json");
+    let t = (1.0f64 / 48.0).to_string();
+    let o = tassel()
+        .args([
+            "sample",
+            fox.to_str().unwrap(),
+            "--clip",
+            "Survey",
+            "--times",
+            &format!("0,{t}"),
+            "--out",
+        ])
+        .arg(&out_file)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let doc: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(&out_file).unwrap()).unwrap();
+    // b_Head_05 (node 8): half way between its first two keys, read off the file, is
+    // their normalised sum.
+    let k0 = [-0.100_036_45f64, -0.313_690_57, -0.407_602_5, 0.851_734_2];
+    let k1 = [-0.100_419_14f64, -0.310_795_37, -0.410_886_97, 0.851_172_2];
+    let sum: Vec<f64> = (0..4).map(|i| k0[i] + k1[i]).collect();
+    let norm = sum.iter().map(|x| x * x).sum::<f64>().sqrt();
+    let r = &doc["samples"][1]["local_r"][8];
+    let dot: f64 = (0..4).map(|i| r[i].as_f64().unwrap() * sum[i] / norm).sum();
+    assert!(dot.abs() > 1.0 - 1e-6, "{r}");
+    // A node without parent has world position = local translation.
+    let s = &doc["samples"][0];
+    let root = doc["nodes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .position(|n| n["name"] == "root")
+        .unwrap();
+    for k in 0..3 {
+        let (w, l) = (
+            s["world_pos"][root][k].as_f64().unwrap(),
+            s["local_t"][root][k].as_f64().unwrap(),
+        );
+        assert!((w - l).abs() < 1e-6);
+    }
+    // A missing clip: a clear error, non-zero exit, no file.
+    let bad = d.join("bad.json");
+    let o = tassel()
+        .args([
+            "sample",
+            fox.to_str().unwrap(),
+            "--clip",
+            "Dance",
+            "--times",
+            "0",
+            "--out",
+        ])
+        .arg(&bad)
+        .output()
+        .unwrap();
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("Dance"));
+    assert!(!bad.exists());
+}
