@@ -46,7 +46,9 @@ pub fn run(a: Args) -> Result<(), String> {
     let dt = 1.0 / a.fps;
     let frames = (DemoScript::DURATION * a.fps).round() as usize;
     let mut locals = sk.rest().to_vec();
-    let mut scratch = locals.clone();
+    let mut animator = script.animator(&c);
+    let mut visited: Vec<String> = Vec::new();
+    let mut events = 0usize;
     let n = sk.len();
     let mut rot_keys: Vec<Vec<Quat>> = vec![Vec::with_capacity(frames + 1); n];
     let mut tr_keys: Vec<Vec<Vec3>> = vec![Vec::with_capacity(frames + 1); n];
@@ -76,7 +78,21 @@ pub fn run(a: Args) -> Result<(), String> {
     for f in 0..=frames {
         let t = f as f32 * dt;
         let m = script.at(t);
-        script.pose(&c, &m, &mut locals, &mut scratch);
+        let plan = script
+            .pose(
+                &c,
+                &mut animator,
+                &m,
+                if f == 0 { 0.0 } else { dt },
+                &mut locals,
+            )
+            .map_err(|e| e.to_string())?;
+        events += plan.events.len();
+        let current = plan.state;
+        let state = animator.machine().state_name(current).to_string();
+        if visited.last() != Some(&state) {
+            visited.push(state);
+        }
         let start = Instant::now();
         sim.frame(&locals, m.component, if f == 0 { 0.0 } else { dt })
             .map_err(|e| e.to_string())?;
@@ -225,6 +241,7 @@ pub fn run(a: Args) -> Result<(), String> {
         sim_time * 1e6 / (frames + 1) as f64
     );
     println!("  teleport resets: {}", sim.state().teleport_count());
+    println!("  states: {} ({events} events)", visited.join(" > "));
     println!(
         "  wrote {} ({} bytes) and {} ({} bytes)",
         glb_path.display(),

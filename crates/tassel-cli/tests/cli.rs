@@ -65,6 +65,11 @@ fn demo_writes_valid_files_and_is_deterministic() {
         );
         let text = String::from_utf8_lossy(&out.stdout);
         assert!(text.contains("joints simulated"), "{text}");
+        // The script's idle, walk, run, stop, turn and jump, as the seed's graph sees them.
+        assert!(
+            text.contains("states: idle > walk_run > idle > jump_start_from_idle > jump_loop_from_idle > jump_end_from_idle > idle"),
+            "{text}"
+        );
     }
     let glb = std::fs::read(a.join("demo.glb")).unwrap();
     assert_eq!(

@@ -1,6 +1,6 @@
 //! The embedded default character: a small humanoid with a ponytail, two side locks, a
 //! tail, a skirt ring, two chest bones and body colliders, procedural clips (idle, walk,
-//! run, jump), and the scripted run of `tassel demo`. Built in code; no file needed.
+//! run, jump start / loop / end), and the scripted run of `tassel demo`. Built in code; no file needed.
 
 use crate::anim::{Channel, Clip, Interpolation, JointTrack};
 use crate::collide::Shape;
@@ -18,7 +18,7 @@ pub struct Character {
     pub skeleton: Skeleton,
     /// Chains and colliders.
     pub rig: RigSettings,
-    /// Clips, in order: idle, walk, run, jump.
+    /// Clips, in order: idle, walk, run, jump_start, jump_loop, jump_end.
     pub clips: Vec<Clip>,
 }
 
@@ -30,8 +30,12 @@ pub mod clip {
     pub const WALK: usize = 1;
     /// Run cycle, 0.7 s loop.
     pub const RUN: usize = 2;
-    /// Crouch, take-off, tuck and landing, 1.2 s.
-    pub const JUMP: usize = 3;
+    /// Crouch and take-off, 0.45 s.
+    pub const JUMP_START: usize = 3;
+    /// Tucked in the air, 0.45 s loop.
+    pub const JUMP_LOOP: usize = 4;
+    /// Landing, 0.3 s.
+    pub const JUMP_END: usize = 5;
 }
 
 fn skeleton() -> Skeleton {
@@ -353,8 +357,9 @@ fn clips(sk: &Skeleton) -> Vec<Clip> {
         }
         .apply(t, l, f)
     });
-    let jump = bake(sk, "jump", 1.2, |t, l, f| {
-        // Crouch (0–0.3), extend (0.3–0.45), tuck in the air (0.45–0.9), land (0.9–1.2).
+    // One jump, cut in three for the state machine: crouch and take-off (0.45 s), tuck in
+    // the air (a 0.45 s loop), landing (0.3 s).
+    let jump_pose = |t: f32, l: &mut [Transform], f: &dyn Fn(&str) -> usize| {
         let crouch = if t < 0.3 {
             (t / 0.3 * PI / 2.0).sin()
         } else if t < 0.45 {
@@ -385,8 +390,11 @@ fn clips(sk: &Skeleton) -> Vec<Clip> {
         }
         rot(l, f("spine"), 0.4 * crouch, 0.0, 0.0);
         l[f("hips")].translation.y -= 0.25 * crouch;
-    });
-    vec![idle, walk, run, jump]
+    };
+    let jump_start = bake(sk, "jump_start", 0.45, |t, l, f| jump_pose(t, l, f));
+    let jump_loop = bake(sk, "jump_loop", 0.45, |t, l, f| jump_pose(0.45 + t, l, f));
+    let jump_end = bake(sk, "jump_end", 0.3, |t, l, f| jump_pose(0.9 + t, l, f));
+    vec![idle, walk, run, jump_start, jump_loop, jump_end]
 }
 
 /// A synthetic benchmark character: a root with `chains` chains of `joints` joints each
@@ -453,36 +461,41 @@ pub fn character() -> Character {
     }
 }
 
-/// One moment of the demo script.
+/// One moment of the demo script: where the character is and the signals it gives the
+/// state machine.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DemoMoment {
     /// The character's world transform.
     pub component: Transform,
-    /// The clip playing and its local time.
-    pub clip: usize,
-    /// Local time in `clip`.
-    pub clip_time: f32,
-    /// The clip fading out, its local time, and the weight of the new clip (0..1).
-    pub fade_from: Option<(usize, f32, f32)>,
+    /// Ground speed, m/s (the `speed` parameter).
+    pub speed: f32,
+    /// The jump button is held (the `jumping` parameter).
+    pub jumping: bool,
     /// A label for the phase: idle, walk, run, stop, turn, jump.
     pub phase: &'static str,
 }
 
 /// The scripted run of `tassel demo`: idle, walk, run, sudden stop, turn in place, jump.
+/// The script moves the character and sets the locomotion state machine's parameters;
+/// the state machine chooses and blends the clips.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct DemoScript;
 
-const SEGMENTS: [(f32, usize, f32, f32, &str); 7] = [
-    // start, clip, forward speed m/s, yaw rate rad/s, label
-    (0.0, clip::IDLE, 0.0, 0.0, "idle"),
-    (1.5, clip::WALK, 1.4, 0.0, "walk"),
-    (3.5, clip::RUN, 4.0, 0.0, "run"),
-    (6.0, clip::IDLE, 0.0, 0.0, "stop"),
-    (7.0, clip::IDLE, 0.0, PI, "turn"),
-    (8.0, clip::JUMP, 0.0, 0.0, "jump"),
-    (9.2, clip::IDLE, 0.0, 0.0, "idle"),
+const SEGMENTS: [(f32, f32, f32, &str); 7] = [
+    // start, forward speed m/s, yaw rate rad/s, label
+    (0.0, 0.0, 0.0, "idle"),
+    (1.5, 1.4, 0.0, "walk"),
+    (3.5, 4.0, 0.0, "run"),
+    (6.0, 0.0, 0.0, "stop"),
+    (7.0, 0.0, PI, "turn"),
+    (8.0, 0.0, 0.0, "jump"),
+    (9.2, 0.0, 0.0, "idle"),
 ];
-const FADE: f32 = 0.2;
+/// The jump: button held from 8.0 s; take-off when the 0.45 s jump_start clip ends; 0.45 s
+/// of flight, 0.4 m high; the button is released on landing.
+const JUMP_AT: f32 = 8.0;
+const TAKE_OFF: f32 = 0.45 + 1.0 / 60.0;
+const FLIGHT: f32 = 0.45;
 
 impl DemoScript {
     /// Length of the script, seconds.
@@ -502,58 +515,58 @@ impl DemoScript {
             seg = i;
             let span = t.min(end) - s.0;
             // Constant yaw rate and speed within a segment: integrate the heading exactly.
-            if s.3 != 0.0 {
-                let y1 = yaw + s.3 * span;
-                pos += Vec3::new(y1.cos() - yaw.cos(), 0.0, yaw.sin() - y1.sin()) * (-s.2 / s.3);
+            if s.2 != 0.0 {
+                let y1 = yaw + s.2 * span;
+                pos += Vec3::new(y1.cos() - yaw.cos(), 0.0, yaw.sin() - y1.sin()) * (-s.1 / s.2);
                 yaw = y1;
             } else {
-                pos += Quat::from_rotation_y(yaw) * Vec3::Z * (s.2 * span);
+                pos += Quat::from_rotation_y(yaw) * Vec3::Z * (s.1 * span);
             }
         }
         let s = SEGMENTS[seg];
-        let local = t - s.0;
-        if s.1 == clip::JUMP {
-            // Flight from 0.45 s to 0.9 s of the clip: a parabola 0.4 m high.
-            let f = ((local - 0.45) / 0.45).clamp(0.0, 1.0);
-            pos.y = 4.0 * 0.4 * f * (1.0 - f);
-        }
-        let fade_from = (seg > 0 && local < FADE && SEGMENTS[seg - 1].1 != s.1).then(|| {
-            let prev = SEGMENTS[seg - 1];
-            (prev.1, t - prev.0, local / FADE)
-        });
+        let since_jump = t - JUMP_AT;
+        let air = ((since_jump - TAKE_OFF) / FLIGHT).clamp(0.0, 1.0);
+        pos.y = 4.0 * 0.4 * air * (1.0 - air);
         DemoMoment {
             component: Transform::from_translation_rotation(pos, Quat::from_rotation_y(yaw)),
-            clip: s.1,
-            clip_time: local,
-            fade_from,
-            phase: s.4,
+            speed: s.1,
+            jumping: (0.0..TAKE_OFF + FLIGHT).contains(&since_jump),
+            phase: s.3,
         }
     }
 
-    /// Writes the animated local pose of moment `m` into `locals` (`scratch` is a second
-    /// buffer of the same size for the cross-fade).
-    pub fn pose(
+    /// The locomotion state machine for the built-in character's clips.
+    pub fn animator(&self, c: &Character) -> crate::anim::Animator {
+        let names: Vec<&str> = c.clips.iter().map(|c| c.name.as_str()).collect();
+        let durations: Vec<f32> = c.clips.iter().map(|c| c.duration).collect();
+        let machine = crate::anim::StateMachine::from_toml_str(
+            crate::anim::StateMachine::LOCOMOTION,
+            &names,
+            &durations,
+        )
+        .expect("the locomotion graph fits the built-in clips");
+        crate::anim::Animator::new(machine, &c.clips)
+    }
+
+    /// Sets `animator`'s parameters from moment `m`, advances it by `dt` and writes the
+    /// blended local pose into `locals`. Returns the plan (state, layers, events).
+    pub fn pose<'a>(
         &self,
         c: &Character,
+        animator: &'a mut crate::anim::Animator,
         m: &DemoMoment,
+        dt: f32,
         locals: &mut [Transform],
-        scratch: &mut [Transform],
-    ) {
-        let sample = |clip: usize, t: f32, out: &mut [Transform]| {
-            out.copy_from_slice(c.skeleton.rest());
-            if clip == clip::JUMP {
-                c.clips[clip].sample(t, out);
-            } else {
-                c.clips[clip].sample_looped(t, out);
-            }
-        };
-        sample(m.clip, m.clip_time, locals);
-        if let Some((from, from_t, w)) = m.fade_from {
-            sample(from, from_t, scratch);
-            for (l, old) in locals.iter_mut().zip(scratch.iter()) {
-                *l = old.lerp(l, w);
-            }
+    ) -> crate::Result<&'a crate::anim::BlendPlan> {
+        let (speed, jumping) = (
+            animator.machine().param("speed"),
+            animator.machine().param("jumping"),
+        );
+        if let (Some(s), Some(j)) = (speed, jumping) {
+            animator.state.set(s, m.speed);
+            animator.state.set(j, if m.jumping { 1.0 } else { 0.0 });
         }
+        animator.update(&c.clips, c.skeleton.rest(), dt, locals)
     }
 }
 
@@ -578,7 +591,7 @@ mod tests {
         assert_eq!(count("skirt_"), 32);
         assert_eq!(count("lock_"), 6);
         assert_eq!(count("chest_"), 2);
-        assert_eq!(c.clips.len(), 4);
+        assert_eq!(c.clips.len(), 6);
         assert!(rig.chain_count() >= 14);
         for clip in &c.clips {
             clip.validate(c.skeleton.len()).unwrap();

@@ -1,6 +1,7 @@
 //! Animation: clips with translation, rotation and scale channels, sampled by the glTF
 //! rules (STEP, LINEAR, CUBICSPLINE), and simple pose blending.
 
+mod animator;
 mod blend;
 mod blend_space;
 mod clip;
@@ -8,6 +9,7 @@ mod root_motion;
 mod sample;
 mod state_machine;
 
+pub use animator::Animator;
 pub use blend::{blend_locals, make_additive, BlendJob, BlendLayer, JointAccumulator};
 pub use blend_space::{BlendSpace1D, BlendSpacePhase};
 pub use clip::{Channel, Clip, Interpolation, JointTrack};
