@@ -2,10 +2,12 @@
 
 use super::blend::{BlendJob, BlendLayer};
 use super::clip::Clip;
+use super::root_motion::RootMotion;
 use super::sample::{Playback, SamplingCursor, SamplingJob};
 use super::state_machine::{BlendPlan, StateMachine, StateMachineState};
 use crate::error::Result;
 use crate::math::Transform;
+use glam::Vec3;
 
 /// Runs a [`StateMachine`] over a set of clips and produces the blended local pose.
 ///
@@ -19,6 +21,10 @@ pub struct Animator {
     plan: BlendPlan,
     cursors: Vec<SamplingCursor>,
     buffers: Vec<Vec<Transform>>,
+    /// When set, the horizontal travel of this joint is taken out of the pose and
+    /// reported by [`Animator::root_motion_delta`] for the character controller.
+    pub root_motion: Option<RootMotion>,
+    delta: Vec3,
 }
 
 impl Animator {
@@ -31,7 +37,15 @@ impl Animator {
             plan: BlendPlan::default(),
             cursors: clips.iter().map(SamplingCursor::new).collect(),
             buffers: Vec::new(),
+            root_motion: None,
+            delta: Vec3::ZERO,
         }
+    }
+
+    /// The root's horizontal travel during the last update (parent space of the root
+    /// joint), blended with the layers' weights; zero without [`Animator::root_motion`].
+    pub fn root_motion_delta(&self) -> Vec3 {
+        self.delta
     }
 
     /// The state machine.
@@ -52,7 +66,13 @@ impl Animator {
         while self.buffers.len() < self.plan.layers.len() {
             self.buffers.push(rest.to_vec());
         }
+        self.delta = Vec3::ZERO;
         for (layer, buf) in self.plan.layers.iter().zip(self.buffers.iter_mut()) {
+            if let Some(rm) = &self.root_motion {
+                let clip = &clips[layer.clip];
+                let t0 = layer.time - layer.rate * dt;
+                self.delta += rm.delta(clip, t0, layer.time, layer.looping) * layer.weight;
+            }
             buf.resize(rest.len(), Transform::IDENTITY);
             buf.copy_from_slice(rest);
             SamplingJob {
@@ -63,6 +83,9 @@ impl Animator {
                 locals: buf,
             }
             .run()?;
+            if let Some(rm) = &self.root_motion {
+                rm.strip(&clips[layer.clip], buf);
+            }
         }
         let mut layers = [BlendLayer {
             locals: rest,

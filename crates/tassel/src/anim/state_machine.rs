@@ -138,6 +138,10 @@ pub struct PlanLayer {
     pub time: f32,
     /// Weight; the layers of one plan sum to 1.
     pub weight: f32,
+    /// Clip seconds played per second of this update (state speed, blend-space rate).
+    pub rate: f32,
+    /// The clip loops (time wraps) rather than holding its last pose.
+    pub looping: bool,
 }
 
 /// What to play this frame.
@@ -460,7 +464,8 @@ impl StateMachine {
         if weight <= 0.0 {
             return;
         }
-        match &self.states[p.state].motion {
+        let state = &self.states[p.state];
+        match &state.motion {
             Motion::Clip { clip, looping } => {
                 let d = self.durations[*clip];
                 let time = if *looping && d > 0.0 {
@@ -468,22 +473,43 @@ impl StateMachine {
                 } else {
                     p.time.clamp(0.0, d)
                 };
+                let rate = if !*looping && p.time >= d {
+                    0.0
+                } else {
+                    state.speed
+                };
                 plan.layers.push(PlanLayer {
                     clip: *clip,
                     time,
                     weight,
+                    rate,
+                    looping: *looping,
                 });
             }
             Motion::Space { space, param } => {
                 scratch.resize(space.points.len(), 0.0);
                 space.weights(values[*param], scratch);
+                let cycle: f32 = space
+                    .points
+                    .iter()
+                    .zip(scratch.iter())
+                    .map(|(pt, w)| w * self.durations[pt.1])
+                    .sum();
                 for (pt, &w) in space.points.iter().zip(scratch.iter()) {
                     if w > 0.0 {
-                        let time = p.phase.phase * self.durations[pt.1];
+                        let d = self.durations[pt.1];
+                        let time = p.phase.phase * d;
+                        let rate = if cycle > 1e-6 {
+                            state.speed * d / cycle
+                        } else {
+                            0.0
+                        };
                         plan.layers.push(PlanLayer {
                             clip: pt.1,
                             time,
                             weight: weight * w,
+                            rate,
+                            looping: true,
                         });
                     }
                 }
