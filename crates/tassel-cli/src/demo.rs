@@ -232,8 +232,9 @@ pub fn run(a: Args) -> Result<(), String> {
     );
     println!("  frames: {}", frames + 1);
     println!(
-        "  chains: {}, joints simulated: {simulated} (of {n}), colliders: {}",
+        "  chains: {}, joints simulated: {simulated} (of {n}), springs: {}, colliders: {}",
         sim.chains().chain_count(),
+        sim.springs().len(),
         sim.chains().collider_count()
     );
     println!(

@@ -5,6 +5,7 @@
 use crate::anim::{Channel, Clip, Interpolation, JointTrack};
 use crate::collide::Shape;
 use crate::dynamics::chain::ChainSettings;
+use crate::dynamics::spring::SpringSettings;
 use crate::dynamics::{ColliderSettings, Curve, RigSettings};
 use crate::math::Transform;
 use crate::skeleton::{Skeleton, SkeletonBuilder};
@@ -191,17 +192,16 @@ fn rig() -> RigSettings {
             colliders: names(&["head"]),
             ..base.clone()
         });
-        chains.push(ChainSettings {
+    }
+    let mut springs = Vec::new();
+    for side in ["l", "r"] {
+        springs.push(SpringSettings {
             name: format!("chest_{side}"),
-            root: format!("chest_{side}"),
-            damping: 0.2,
-            stiffness: 0.35,
-            dummy_bone_length: 0.06,
-            radius: 0.0,
-            limit_angle: 25.0,
-            gravity: Vec3::new(0.0, -2.0, 0.0),
-            world_damping_location: 0.6,
-            ..base.clone()
+            bone: format!("chest_{side}"),
+            stiffness: 120.0,
+            damping: 6.0,
+            limit_displacement: 0.03,
+            ..Default::default()
         });
     }
     for k in 0..8 {
@@ -216,7 +216,11 @@ fn rig() -> RigSettings {
             ..base.clone()
         });
     }
-    RigSettings { chains, colliders }
+    RigSettings {
+        chains,
+        colliders,
+        springs,
+    }
 }
 
 /// Samples a procedural clip at 30 keys per second into LINEAR channels.
@@ -592,7 +596,8 @@ mod tests {
         assert_eq!(count("lock_"), 6);
         assert_eq!(count("chest_"), 2);
         assert_eq!(c.clips.len(), 6);
-        assert!(rig.chain_count() >= 14);
+        assert_eq!(rig.chain_count(), 12);
+        assert_eq!(c.rig.springs.len(), 2);
         for clip in &c.clips {
             clip.validate(c.skeleton.len()).unwrap();
         }

@@ -1,6 +1,7 @@
 //! One character's secondary-motion frame, wiring skeleton, chain rig and state together.
 
 use crate::dynamics::chain::{ChainJob, ChainRig, ChainState};
+use crate::dynamics::spring::{SpringJob, SpringRig, SpringState};
 use crate::dynamics::RigSettings;
 use crate::error::{Error, Result};
 use crate::math::Transform;
@@ -22,6 +23,8 @@ pub struct CharacterSim {
     skeleton: Skeleton,
     rig: ChainRig,
     state: ChainState,
+    springs: SpringRig,
+    spring_state: SpringState,
     pose: Pose,
     animated_models: Vec<Transform>,
 }
@@ -31,12 +34,16 @@ impl CharacterSim {
     pub fn new(skeleton: Skeleton, rig: &RigSettings) -> Result<Self> {
         let chains = ChainRig::new(&skeleton, rig)?;
         let state = ChainState::new(&chains);
+        let springs = SpringRig::new(&skeleton, &rig.springs)?;
+        let spring_state = SpringState::new(&springs);
         let pose = Pose::rest(&skeleton);
         let animated_models = pose.models.clone();
         Ok(Self {
             skeleton,
             rig: chains,
             state,
+            springs,
+            spring_state,
             pose,
             animated_models,
         })
@@ -76,6 +83,18 @@ impl CharacterSim {
             models: &mut self.pose.models,
         }
         .run()?;
+        if !self.springs.is_empty() {
+            SpringJob {
+                skeleton: &self.skeleton,
+                rig: &self.springs,
+                state: &mut self.spring_state,
+                component,
+                dt,
+                locals: &mut self.pose.locals,
+                models: &mut self.pose.models,
+            }
+            .run()?;
+        }
         Ok(&self.pose)
     }
 
@@ -94,6 +113,16 @@ impl CharacterSim {
         &self.state
     }
 
+    /// The compiled springs.
+    pub fn springs(&self) -> &SpringRig {
+        &self.springs
+    }
+
+    /// The spring state.
+    pub fn spring_state(&self) -> &SpringState {
+        &self.spring_state
+    }
+
     /// The last output pose.
     pub fn pose(&self) -> &Pose {
         &self.pose
@@ -107,5 +136,6 @@ impl CharacterSim {
     /// Starts the chains again from the animated pose on the next frame.
     pub fn reset(&mut self) {
         self.state.reset();
+        self.spring_state.reset();
     }
 }

@@ -92,6 +92,7 @@ fn pendulum_period_matches_small_angle_formula() {
     let rig = RigSettings {
         chains: vec![free(TimeMode::Fixed, 600.0)],
         colliders: vec![],
+        springs: vec![],
     };
     let mut sim = Sim::new(sk, rig);
     // Stiffness 0: the animated pose only sets the start. Record x(t) and find the times
@@ -135,6 +136,7 @@ fn chain_released_horizontally_hangs_straight_down() {
             RigSettings {
                 chains: vec![s],
                 colliders: vec![],
+                springs: vec![],
             },
         );
         let mut pts = Vec::new();
@@ -163,6 +165,7 @@ fn stiffness_one_gives_the_animated_pose() {
             RigSettings {
                 chains: vec![s],
                 colliders: vec![],
+                springs: vec![],
             },
         );
         let rest = Pose::rest(&sk);
@@ -240,6 +243,7 @@ fn points_never_end_a_frame_inside_colliders() {
         let rig = RigSettings {
             chains: vec![s],
             colliders: shapes.to_vec(),
+            springs: vec![],
         };
         let mut sim = Sim::new(sk, rig);
         let mut worst = f32::MIN;
@@ -284,6 +288,7 @@ fn sway(mode: TimeMode, hz: f32, seconds: f32) -> (Vec<f32>, Vec<Vec3>, Vec<Vec3
         RigSettings {
             chains: vec![s],
             colliders: vec![],
+            springs: vec![],
         },
     );
     let rest = Pose::rest(&sk);
@@ -359,6 +364,7 @@ fn bad_time_steps_and_hitches() {
         RigSettings {
             chains: vec![free(TimeMode::Fixed, 60.0)],
             colliders: vec![],
+            springs: vec![],
         },
     );
     let mut locals = sk.rest().to_vec();
@@ -401,6 +407,7 @@ fn same_inputs_same_bits() {
             RigSettings {
                 chains: vec![s],
                 colliders: vec![],
+                springs: vec![],
             },
         );
         let mut bits = Vec::new();
@@ -428,6 +435,7 @@ fn wind_pushes_the_chain_downwind() {
         RigSettings {
             chains: vec![s],
             colliders: vec![],
+            springs: vec![],
         },
     );
     let mut pts = Vec::new();
@@ -450,6 +458,7 @@ fn alpha_warmup_and_turn_teleport() {
         RigSettings {
             chains: vec![s],
             colliders: vec![],
+            springs: vec![],
         },
     );
     let rest = Pose::rest(&sk);
@@ -468,6 +477,7 @@ fn alpha_warmup_and_turn_teleport() {
         RigSettings {
             chains: vec![s],
             colliders: vec![],
+            springs: vec![],
         },
     );
     let pts = sim.frame(Transform::IDENTITY, 0.0);
@@ -482,6 +492,7 @@ fn alpha_warmup_and_turn_teleport() {
         RigSettings {
             chains: vec![free(TimeMode::Fixed, 60.0)],
             colliders: vec![],
+            springs: vec![],
         },
     );
     for _ in 0..20 {

@@ -4,6 +4,7 @@
 pub mod chain;
 mod curve;
 mod rig;
+pub mod spring;
 
 pub use curve::Curve;
 pub use rig::{ColliderSettings, RigSettings};

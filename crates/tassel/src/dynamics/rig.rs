@@ -3,6 +3,7 @@
 
 use crate::collide::Shape;
 use crate::dynamics::chain::ChainSettings;
+use crate::dynamics::spring::SpringSettings;
 use crate::error::{Error, Result};
 use crate::skeleton::Skeleton;
 use glam::{Quat, Vec3};
@@ -42,6 +43,9 @@ pub struct RigSettings {
     /// Colliders (`[[collider]]` tables).
     #[serde(default, rename = "collider")]
     pub colliders: Vec<ColliderSettings>,
+    /// Spring bones (`[[spring]]` tables).
+    #[serde(default, rename = "spring")]
+    pub springs: Vec<SpringSettings>,
 }
 
 impl RigSettings {
@@ -62,6 +66,9 @@ impl RigSettings {
     pub fn validate(&self) -> Result<()> {
         for c in &self.chains {
             c.validate()?;
+        }
+        for s in &self.springs {
+            s.validate()?;
         }
         for (i, col) in self.colliders.iter().enumerate() {
             let what = format!("collider '{}'", col.name);
@@ -112,6 +119,9 @@ impl RigSettings {
         }
         for col in &self.colliders {
             need(format!("collider '{}' bone", col.name), &col.bone)?;
+        }
+        for s in &self.springs {
+            need(format!("spring '{}' bone", s.name), &s.bone)?;
         }
         Ok(())
     }
