@@ -3,6 +3,7 @@
 
 pub mod chain;
 mod curve;
+pub mod particles;
 mod rig;
 pub mod spring;
 
