@@ -24,8 +24,7 @@ fn main() -> Result<(), tassel::Error> {
         top,
         Vec3::new(0.0, 0.0, width),
         Vec3::new(0.0, -height, 0.0),
-        nx,
-        ny,
+        [nx, ny],
         true,
         0.2,
     );

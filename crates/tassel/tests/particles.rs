@@ -247,7 +247,7 @@ fn gusts_are_seeded_and_deterministic() {
             seed,
             ..Default::default()
         });
-        let ids = w.add_cloth(Vec3::ZERO, Vec3::X, Vec3::NEG_Y, 4, 4, true, 1.0);
+        let ids = w.add_cloth(Vec3::ZERO, Vec3::X, Vec3::NEG_Y, [4, 4], true, 1.0);
         w.pin(ids[0], Vec3::ZERO).unwrap();
         for _ in 0..120 {
             w.step(1.0 / 60.0).unwrap();
@@ -265,12 +265,12 @@ fn gusts_are_seeded_and_deterministic() {
 #[test]
 fn cloth_builder_counts_by_hand() {
     let mut w = ParticleWorld::new(ParticleSettings::default());
-    let ids = w.add_cloth(Vec3::ZERO, Vec3::X, Vec3::Y, 4, 3, true, 1.0);
+    let ids = w.add_cloth(Vec3::ZERO, Vec3::X, Vec3::Y, [4, 3], true, 1.0);
     assert_eq!(ids.len(), 12);
     // Horizontal 3·3, vertical 4·2, two diagonals in each of 3·2 cells.
     assert_eq!(w.sticks().len(), 9 + 8 + 12);
     let mut plain = ParticleWorld::new(ParticleSettings::default());
-    plain.add_cloth(Vec3::ZERO, Vec3::X, Vec3::Y, 4, 3, false, 1.0);
+    plain.add_cloth(Vec3::ZERO, Vec3::X, Vec3::Y, [4, 3], false, 1.0);
     assert_eq!(plain.sticks().len(), 17);
 }
 
@@ -296,7 +296,7 @@ fn bad_input_is_an_error_naming_the_problem() {
 #[test]
 fn a_huge_time_step_is_capped_and_stays_finite() {
     let mut w = ParticleWorld::new(ParticleSettings::default());
-    let ids = w.add_cloth(Vec3::ZERO, Vec3::X, Vec3::NEG_Z, 5, 5, true, 1.0);
+    let ids = w.add_cloth(Vec3::ZERO, Vec3::X, Vec3::NEG_Z, [5, 5], true, 1.0);
     w.pin(ids[0], Vec3::ZERO).unwrap();
     w.add_ground(-3.0);
     w.step(1.0e6).unwrap();

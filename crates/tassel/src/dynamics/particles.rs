@@ -399,7 +399,7 @@ impl ParticleWorld {
         ids
     }
 
-    /// A cloth grid of `nx × ny` particles spanning `origin + u·[0,1] + v·[0,1]`, with
+    /// A cloth grid of `count = [nx, ny]` particles spanning `origin + u·[0,1] + v·[0,1]`, with
     /// horizontal and vertical sticks and, with `shear`, both diagonals. Returns indices
     /// row by row (`ids[y * nx + x]`).
     pub fn add_cloth(
@@ -407,12 +407,11 @@ impl ParticleWorld {
         origin: Vec3,
         u: Vec3,
         v: Vec3,
-        nx: usize,
-        ny: usize,
+        count: [usize; 2],
         shear: bool,
         mass: f32,
     ) -> Vec<usize> {
-        let (nx, ny) = (nx.max(2), ny.max(2));
+        let (nx, ny) = (count[0].max(2), count[1].max(2));
         let m = mass / (nx * ny) as f32;
         let mut ids = Vec::with_capacity(nx * ny);
         for y in 0..ny {
