@@ -7,6 +7,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 use tassel::builtin::{self, DemoScript};
 use tassel::collide::Shape;
+use tassel::dynamics::cloth::ConstraintKind;
 use tassel::CharacterSim;
 use tassel_gltf::{export_glb, BakedClip, BakedTrack, BoneMesh, ExportSource};
 
@@ -53,25 +54,41 @@ pub fn run(a: Args) -> Result<(), String> {
     let mut rot_keys: Vec<Vec<Quat>> = vec![Vec::with_capacity(frames + 1); n];
     let mut tr_keys: Vec<Vec<Vec3>> = vec![Vec::with_capacity(frames + 1); n];
     let mut times = Vec::with_capacity(frames + 1);
-    // Chain membership per joint, for colours.
-    let mut chain_of: Vec<Option<usize>> = vec![None; n];
+    // Solver membership per joint (chain or cloth name), for colours.
+    let mut group_of: Vec<Option<String>> = vec![None; n];
     for p in 0..sim.chains().point_count() {
         let info = sim.chains().point(p);
         if let (Some(j), Some(_)) = (info.joint, info.parent) {
-            chain_of[j] = Some(info.chain);
+            group_of[j] = Some(sim.chains().chain_settings(info.chain).name.clone());
         }
     }
-    let tracked = ["ponytail", "tail", "skirt_0", "lock_l"];
-    let tips: Vec<usize> = tracked
+    for ci in 0..sim.cloths().cloth_count() {
+        let name = &sim.cloths().settings(ci).name;
+        for ch in sim.cloths().chains(ci) {
+            for p in ch.clone() {
+                if let Some(j) = sim.cloths().joint(p) {
+                    if !sim.cloths().is_fixed(p) {
+                        group_of[j] = Some(name.clone());
+                    }
+                }
+            }
+        }
+    }
+    // Tips whose distance from their animated place is plotted: chains by name, and the
+    // skirt cloth's first chain.
+    let tracked = ["ponytail", "tail", "skirt", "lock_l"];
+    let chain_tips: Vec<Option<usize>> = tracked
         .iter()
         .map(|name| {
-            let ci = (0..sim.chains().chain_count())
+            (0..sim.chains().chain_count())
                 .find(|&i| sim.chains().chain_settings(i).name == *name)
-                .unwrap_or(0);
-            sim.chains().chain_points(ci).end - 1
+                .map(|ci| sim.chains().chain_points(ci).end - 1)
         })
         .collect();
-    let mut deviation: Vec<Vec<f32>> = vec![Vec::new(); tips.len()];
+    let skirt_tip = (0..sim.cloths().cloth_count())
+        .find(|&i| sim.cloths().settings(i).name == "skirt")
+        .map(|ci| sim.cloths().chains(ci)[0].end - 1);
+    let mut deviation: Vec<Vec<f32>> = vec![Vec::new(); tracked.len()];
     let mut panels = Vec::new();
     let mut next_moment = 0;
     let mut sim_time = 0.0f64;
@@ -109,8 +126,14 @@ pub fn run(a: Args) -> Result<(), String> {
         }
         let out = sim.state().output_positions();
         let targets = sim.state().target_positions();
-        for (k, &tip) in tips.iter().enumerate() {
-            deviation[k].push((out[tip] - targets[tip]).length());
+        let cloth_out = sim.cloth_state().output_positions();
+        let cloth_targets = sim.cloth_state().target_positions();
+        for (k, name) in tracked.iter().enumerate() {
+            let d = match (*name, skirt_tip) {
+                ("skirt", Some(p)) => (cloth_out[p] - cloth_targets[p]).length(),
+                _ => chain_tips[k].map_or(0.0, |p| (out[p] - targets[p]).length()),
+            };
+            deviation[k].push(d);
         }
         if next_moment < MOMENTS.len() && t + 0.5 * dt >= MOMENTS[next_moment] {
             next_moment += 1;
@@ -121,7 +144,7 @@ pub fn run(a: Args) -> Result<(), String> {
             let mut segments = Vec::new();
             let anim = sim.animated_models();
             for j in 0..n {
-                if let (Some(p), Some(_)) = (sk.parent(j), chain_of[j]) {
+                if let (Some(p), Some(_)) = (sk.parent(j), &group_of[j]) {
                     segments.push((
                         view(anim[p].translation),
                         view(anim[j].translation),
@@ -132,8 +155,8 @@ pub fn run(a: Args) -> Result<(), String> {
             }
             for j in 0..n {
                 let Some(p) = sk.parent(j) else { continue };
-                let (col, w) = match chain_of[j] {
-                    Some(ci) => (chain_color(&sim.chains().chain_settings(ci).name), 3.0),
+                let (col, w) = match &group_of[j] {
+                    Some(name) => (chain_color(name), 3.0),
                     None => ([70, 70, 70], 2.5),
                 };
                 segments.push((
@@ -148,6 +171,22 @@ pub fn run(a: Args) -> Result<(), String> {
                 if let (None, Some(parent)) = (info.joint, info.parent) {
                     let col = chain_color(&sim.chains().chain_settings(info.chain).name);
                     segments.push((view(out[parent]), view(out[p]), col, 3.0));
+                }
+            }
+            // The cloth: virtual tips and the rings across its chains.
+            for ci in 0..sim.cloths().cloth_count() {
+                let col = chain_color(&sim.cloths().settings(ci).name);
+                for ch in sim.cloths().chains(ci) {
+                    let last = ch.end - 1;
+                    if sim.cloths().joint(last).is_none() && last > ch.start {
+                        segments.push((view(cloth_out[last - 1]), view(cloth_out[last]), col, 3.0));
+                    }
+                }
+                for c in sim.cloths().constraints(ci) {
+                    if c.kind == ConstraintKind::StructuralHorizontal {
+                        let (a, b) = (c.a as usize, c.b as usize);
+                        segments.push((view(cloth_out[a]), view(cloth_out[b]), col, 1.0));
+                    }
                 }
             }
             let mut circles = Vec::new();
@@ -224,7 +263,8 @@ pub fn run(a: Args) -> Result<(), String> {
     let png_path = a.out.join("demo.png");
     write_atomic(&glb_path, &glb)?;
     write_atomic(&png_path, &png)?;
-    let simulated = sim.chains().point_count() - sim.chains().chain_count();
+    let simulated = sim.chains().point_count() - sim.chains().chain_count()
+        + sim.cloths().simulated_joints().count();
     println!(
         "tassel demo: idle, walk, run, sudden stop, turn in place, jump ({:.0} s at {} Hz)",
         DemoScript::DURATION,
@@ -232,8 +272,10 @@ pub fn run(a: Args) -> Result<(), String> {
     );
     println!("  frames: {}", frames + 1);
     println!(
-        "  chains: {}, joints simulated: {simulated} (of {n}), springs: {}, colliders: {}",
+        "  chains: {}, cloths: {} ({} points), springs: {}, joints simulated: {simulated} (of {n}), colliders: {}",
         sim.chains().chain_count(),
+        sim.cloths().cloth_count(),
+        sim.cloths().point_count(),
         sim.springs().len(),
         sim.chains().collider_count()
     );
@@ -241,7 +283,11 @@ pub fn run(a: Args) -> Result<(), String> {
         "  time per frame (secondary motion incl. pose jobs): {:.1} us",
         sim_time * 1e6 / (frames + 1) as f64
     );
-    println!("  teleport resets: {}", sim.state().teleport_count());
+    println!(
+        "  teleport resets: {} (chains), {} (cloths)",
+        sim.state().teleport_count(),
+        sim.cloth_state().reset_count()
+    );
     println!("  states: {} ({events} events)", visited.join(" > "));
     println!(
         "  wrote {} ({} bytes) and {} ({} bytes)",

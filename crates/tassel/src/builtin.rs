@@ -5,6 +5,7 @@
 use crate::anim::{Channel, Clip, Interpolation, JointTrack};
 use crate::collide::Shape;
 use crate::dynamics::chain::ChainSettings;
+use crate::dynamics::cloth::ClothSettings;
 use crate::dynamics::spring::SpringSettings;
 use crate::dynamics::{ColliderSettings, Curve, RigSettings};
 use crate::math::Transform;
@@ -204,22 +205,27 @@ fn rig() -> RigSettings {
             ..Default::default()
         });
     }
-    for k in 0..8 {
-        chains.push(ChainSettings {
-            name: format!("skirt_{k}"),
-            root: format!("skirt_{k}_0"),
-            damping: 0.15,
-            stiffness: 0.12,
-            radius: 0.02,
-            world_damping_location: 0.7,
-            colliders: names(&["thigh_l", "thigh_r", "shin_l", "shin_r"]),
-            ..base.clone()
-        });
-    }
+    // The skirt is one bone cloth over its eight chains, closed into a ring.
+    let cloths = vec![ClothSettings {
+        name: "skirt".into(),
+        chains: (0..8)
+            .map(|k| [format!("skirt_{k}_0"), format!("skirt_{k}_3")])
+            .collect(),
+        loop_chains: true,
+        virtual_bone_length: 0.08,
+        resistance: 0.08,
+        hardness: 0.01,
+        radius: 0.015,
+        friction: 0.3,
+        limit_angle: 60.0,
+        colliders: names(&["thigh_l", "thigh_r", "shin_l", "shin_r"]),
+        ..Default::default()
+    }];
     RigSettings {
         chains,
         colliders,
         springs,
+        cloths,
     }
 }
 
@@ -596,8 +602,16 @@ mod tests {
         assert_eq!(count("lock_"), 6);
         assert_eq!(count("chest_"), 2);
         assert_eq!(c.clips.len(), 6);
-        assert_eq!(rig.chain_count(), 12);
+        assert_eq!(rig.chain_count(), 4);
         assert_eq!(c.rig.springs.len(), 2);
+        // The skirt cloth: 8 chains of 4 bones and a virtual tip, closed into a ring.
+        let cloth = crate::dynamics::cloth::ClothRig::new(&c.skeleton, &c.rig).unwrap();
+        assert_eq!(cloth.point_count(), 40);
+        assert_eq!(cloth.simulated_joints().count(), 24);
+        assert_eq!(cloth.quads(0).len(), 32);
+        // By hand: vertical 8·4, bending 8·3, horizontal 8·5 minus the 8 between fixed
+        // roots, shear 8·4·2.
+        assert_eq!(cloth.constraints(0).len(), 32 + 24 + 32 + 64);
         for clip in &c.clips {
             clip.validate(c.skeleton.len()).unwrap();
         }

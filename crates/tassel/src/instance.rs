@@ -1,6 +1,7 @@
 //! One character's secondary-motion frame, wiring skeleton, chain rig and state together.
 
 use crate::dynamics::chain::{ChainJob, ChainRig, ChainState};
+use crate::dynamics::cloth::{ClothJob, ClothRig, ClothState};
 use crate::dynamics::spring::{SpringJob, SpringRig, SpringState};
 use crate::dynamics::RigSettings;
 use crate::error::{Error, Result};
@@ -25,6 +26,8 @@ pub struct CharacterSim {
     state: ChainState,
     springs: SpringRig,
     spring_state: SpringState,
+    cloths: ClothRig,
+    cloth_state: ClothState,
     pose: Pose,
     animated_models: Vec<Transform>,
 }
@@ -36,6 +39,23 @@ impl CharacterSim {
         let state = ChainState::new(&chains);
         let springs = SpringRig::new(&skeleton, &rig.springs)?;
         let spring_state = SpringState::new(&springs);
+        let cloths = ClothRig::new(&skeleton, rig)?;
+        let cloth_state = ClothState::new(&cloths);
+        // One solver per bone: a cloth bone must not also be a chain's or a spring's.
+        for j in cloths.simulated_joints() {
+            let in_chain = (0..chains.point_count()).any(|p| chains.point(p).joint == Some(j));
+            let in_spring = rig
+                .springs
+                .iter()
+                .any(|s| skeleton.find(&s.bone) == Some(j));
+            if in_chain || in_spring {
+                return Err(Error::InvalidParameter(format!(
+                    "bone '{}' is simulated by a cloth and by a {}",
+                    skeleton.name(j),
+                    if in_chain { "chain" } else { "spring" }
+                )));
+            }
+        }
         let pose = Pose::rest(&skeleton);
         let animated_models = pose.models.clone();
         Ok(Self {
@@ -44,6 +64,8 @@ impl CharacterSim {
             state,
             springs,
             spring_state,
+            cloths,
+            cloth_state,
             pose,
             animated_models,
         })
@@ -95,6 +117,18 @@ impl CharacterSim {
             }
             .run()?;
         }
+        if !self.cloths.is_empty() {
+            ClothJob {
+                skeleton: &self.skeleton,
+                rig: &self.cloths,
+                state: &mut self.cloth_state,
+                component,
+                dt,
+                locals: &mut self.pose.locals,
+                models: &mut self.pose.models,
+            }
+            .run()?;
+        }
         Ok(&self.pose)
     }
 
@@ -123,6 +157,16 @@ impl CharacterSim {
         &self.spring_state
     }
 
+    /// The compiled cloths.
+    pub fn cloths(&self) -> &ClothRig {
+        &self.cloths
+    }
+
+    /// The cloth state (output positions, placed colliders...).
+    pub fn cloth_state(&self) -> &ClothState {
+        &self.cloth_state
+    }
+
     /// The last output pose.
     pub fn pose(&self) -> &Pose {
         &self.pose
@@ -137,5 +181,6 @@ impl CharacterSim {
     pub fn reset(&mut self) {
         self.state.reset();
         self.spring_state.reset();
+        self.cloth_state.reset();
     }
 }

@@ -221,6 +221,53 @@ pub fn closest_params_segment_segment(p1: Vec3, q1: Vec3, p2: Vec3, q2: Vec3) ->
     (s, t)
 }
 
+/// Closest point to `p` on the triangle `a`, `b`, `c` (Ericson, Real-Time Collision
+/// Detection §5.1.5, by Voronoi regions).
+pub fn closest_point_on_triangle(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> Vec3 {
+    let ab = b - a;
+    let ac = c - a;
+    let ap = p - a;
+    let d1 = ab.dot(ap);
+    let d2 = ac.dot(ap);
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return a;
+    }
+    let bp = p - b;
+    let d3 = ab.dot(bp);
+    let d4 = ac.dot(bp);
+    if d3 >= 0.0 && d4 <= d3 {
+        return b;
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        let v = d1 / (d1 - d3);
+        return a + ab * v;
+    }
+    let cp = p - c;
+    let d5 = ab.dot(cp);
+    let d6 = ac.dot(cp);
+    if d6 >= 0.0 && d5 <= d6 {
+        return c;
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        let w = d2 / (d2 - d6);
+        return a + ac * w;
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        return b + (c - b) * w;
+    }
+    let denom = va + vb + vc;
+    if denom.abs() < 1e-30 {
+        return a;
+    }
+    let v = vb / denom;
+    let w = vc / denom;
+    a + ab * v + ac * w
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -286,5 +333,22 @@ mod tests {
             Vec3::new(0.0, 1.0, 1.0),
         );
         assert!((s - 0.5).abs() < 1e-6 && (t - 0.5).abs() < 1e-6);
+    }
+
+    #[test]
+    fn closest_point_on_triangle_by_region() {
+        let (a, b, c) = (Vec3::ZERO, Vec3::X, Vec3::Y);
+        // Above the face: straight down onto it.
+        let q = closest_point_on_triangle(Vec3::new(0.2, 0.3, 5.0), a, b, c);
+        assert!((q - Vec3::new(0.2, 0.3, 0.0)).length() < 1e-6);
+        // Beyond a vertex, beyond an edge, beyond the hypotenuse.
+        assert_eq!(
+            closest_point_on_triangle(Vec3::new(-1.0, -1.0, 1.0), a, b, c),
+            a
+        );
+        let q = closest_point_on_triangle(Vec3::new(0.5, -2.0, 0.0), a, b, c);
+        assert!((q - Vec3::new(0.5, 0.0, 0.0)).length() < 1e-6);
+        let q = closest_point_on_triangle(Vec3::new(1.0, 1.0, 0.0), a, b, c);
+        assert!((q - Vec3::new(0.5, 0.5, 0.0)).length() < 1e-6);
     }
 }

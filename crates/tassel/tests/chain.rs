@@ -93,6 +93,7 @@ fn pendulum_period_matches_small_angle_formula() {
         chains: vec![free(TimeMode::Fixed, 600.0)],
         colliders: vec![],
         springs: vec![],
+        cloths: vec![],
     };
     let mut sim = Sim::new(sk, rig);
     // Stiffness 0: the animated pose only sets the start. Record x(t) and find the times
@@ -137,6 +138,7 @@ fn chain_released_horizontally_hangs_straight_down() {
                 chains: vec![s],
                 colliders: vec![],
                 springs: vec![],
+                cloths: vec![],
             },
         );
         let mut pts = Vec::new();
@@ -166,6 +168,7 @@ fn stiffness_one_gives_the_animated_pose() {
                 chains: vec![s],
                 colliders: vec![],
                 springs: vec![],
+                cloths: vec![],
             },
         );
         let rest = Pose::rest(&sk);
@@ -244,6 +247,7 @@ fn points_never_end_a_frame_inside_colliders() {
             chains: vec![s],
             colliders: shapes.to_vec(),
             springs: vec![],
+            cloths: vec![],
         };
         let mut sim = Sim::new(sk, rig);
         let mut worst = f32::MIN;
@@ -289,6 +293,7 @@ fn sway(mode: TimeMode, hz: f32, seconds: f32) -> (Vec<f32>, Vec<Vec3>, Vec<Vec3
             chains: vec![s],
             colliders: vec![],
             springs: vec![],
+            cloths: vec![],
         },
     );
     let rest = Pose::rest(&sk);
@@ -365,6 +370,7 @@ fn bad_time_steps_and_hitches() {
             chains: vec![free(TimeMode::Fixed, 60.0)],
             colliders: vec![],
             springs: vec![],
+            cloths: vec![],
         },
     );
     let mut locals = sk.rest().to_vec();
@@ -408,6 +414,7 @@ fn same_inputs_same_bits() {
                 chains: vec![s],
                 colliders: vec![],
                 springs: vec![],
+                cloths: vec![],
             },
         );
         let mut bits = Vec::new();
@@ -436,6 +443,7 @@ fn wind_pushes_the_chain_downwind() {
             chains: vec![s],
             colliders: vec![],
             springs: vec![],
+            cloths: vec![],
         },
     );
     let mut pts = Vec::new();
@@ -459,6 +467,7 @@ fn alpha_warmup_and_turn_teleport() {
             chains: vec![s],
             colliders: vec![],
             springs: vec![],
+            cloths: vec![],
         },
     );
     let rest = Pose::rest(&sk);
@@ -478,6 +487,7 @@ fn alpha_warmup_and_turn_teleport() {
             chains: vec![s],
             colliders: vec![],
             springs: vec![],
+            cloths: vec![],
         },
     );
     let pts = sim.frame(Transform::IDENTITY, 0.0);
@@ -493,6 +503,7 @@ fn alpha_warmup_and_turn_teleport() {
             chains: vec![free(TimeMode::Fixed, 60.0)],
             colliders: vec![],
             springs: vec![],
+            cloths: vec![],
         },
     );
     for _ in 0..20 {

@@ -119,6 +119,14 @@ impl PlacedCollider {
         }
     }
 
+    /// The collider moved a share `w` of the way from `self` to `other` (shape of `other`).
+    pub fn lerp(&self, other: &PlacedCollider, w: f32) -> PlacedCollider {
+        PlacedCollider {
+            shape: other.shape,
+            transform: self.transform.lerp(&other.transform, w),
+        }
+    }
+
     /// How far a point of radius `r` at `p` violates the collider (≤ 0 when it does not).
     pub fn penetration(&self, p: Vec3, r: f32) -> f32 {
         let t = &self.transform;

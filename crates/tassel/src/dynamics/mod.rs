@@ -1,7 +1,9 @@
-//! Secondary motion solvers. `chain` is the KawaiiPhysics-style bone chain (seed 000),
-//! with colliders, limits, teleport handling and two time modes.
+//! Secondary motion solvers: `chain`, the KawaiiPhysics-style bone chain (seed 000);
+//! `spring`, Unreal's spring controller (seed 002); `cloth`, SPCRJointDynamics' bone cloth
+//! (seed 004); `particles`, a general Verlet particle-constraint world (seed 001).
 
 pub mod chain;
+pub mod cloth;
 mod curve;
 pub mod particles;
 mod rig;

@@ -3,6 +3,7 @@
 
 use crate::collide::Shape;
 use crate::dynamics::chain::ChainSettings;
+use crate::dynamics::cloth::ClothSettings;
 use crate::dynamics::spring::SpringSettings;
 use crate::error::{Error, Result};
 use crate::skeleton::Skeleton;
@@ -46,6 +47,9 @@ pub struct RigSettings {
     /// Spring bones (`[[spring]]` tables).
     #[serde(default, rename = "spring")]
     pub springs: Vec<SpringSettings>,
+    /// Bone cloths (`[[cloth]]` tables).
+    #[serde(default, rename = "cloth")]
+    pub cloths: Vec<ClothSettings>,
 }
 
 impl RigSettings {
@@ -69,6 +73,23 @@ impl RigSettings {
         }
         for s in &self.springs {
             s.validate()?;
+        }
+        for (i, c) in self.cloths.iter().enumerate() {
+            c.validate()?;
+            if self.cloths[..i].iter().any(|o| o.name == c.name) {
+                return Err(Error::InvalidParameter(format!(
+                    "two cloths are named '{}'",
+                    c.name
+                )));
+            }
+            for name in &c.colliders {
+                if !self.colliders.iter().any(|o| &o.name == name) {
+                    return Err(Error::InvalidParameter(format!(
+                        "cloth '{}' names collider '{name}', which the rig does not define",
+                        c.name
+                    )));
+                }
+            }
         }
         for (i, col) in self.colliders.iter().enumerate() {
             let what = format!("collider '{}'", col.name);
@@ -122,6 +143,12 @@ impl RigSettings {
         }
         for s in &self.springs {
             need(format!("spring '{}' bone", s.name), &s.bone)?;
+        }
+        for c in &self.cloths {
+            for [root, end] in &c.chains {
+                need(format!("cloth '{}' chain root", c.name), root)?;
+                need(format!("cloth '{}' chain end", c.name), end)?;
+            }
         }
         Ok(())
     }
@@ -177,5 +204,38 @@ offset = [0.0, 0.05, 0.0]
             RigSettings::from_toml_str(&typo),
             Err(Error::RigParse(_))
         ));
+    }
+
+    #[test]
+    fn parses_a_cloth_table() {
+        let text = r#"
+[[cloth]]
+name = "skirt"
+chains = [["s0_0", "s0_3"], ["s1_0", "s1_3"], ["s2_0", "s2_3"]]
+loop_chains = true
+virtual_bone_length = 0.05
+surface_collision = "push"
+stretch.shear = [[0.0, 0.5], [1.0, 0.2]]
+constraints.bending_horizontal = true
+wind.acceleration = [1.0, 0.0, 0.0]
+"#;
+        let rig = RigSettings::from_toml_str(text).unwrap();
+        let c = &rig.cloths[0];
+        assert!(c.loop_chains && c.constraints.bending_horizontal);
+        assert_eq!(c.chains[2], ["s2_0".to_string(), "s2_3".to_string()]);
+        assert_eq!(c.stretch.shear.eval(0.5), 0.35);
+        assert_eq!(c.iterations, ClothSettings::default().iterations);
+        assert_eq!(
+            c.surface_collision,
+            crate::dynamics::cloth::SurfaceCollision::Push
+        );
+        let again = RigSettings::from_toml_str(&rig.to_toml_string().unwrap()).unwrap();
+        assert_eq!(again, rig);
+        let bad = text.replace("virtual_bone_length = 0.05", "virtual_bone_length = -1.0");
+        let e = RigSettings::from_toml_str(&bad).unwrap_err().to_string();
+        assert!(
+            e.contains("skirt") && e.contains("virtual_bone_length"),
+            "{e}"
+        );
     }
 }

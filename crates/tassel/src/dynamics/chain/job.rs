@@ -135,13 +135,6 @@ pub struct ChainJob<'a> {
     pub models: &'a mut [Transform],
 }
 
-fn lerp_collider(a: &PlacedCollider, b: &PlacedCollider, w: f32) -> PlacedCollider {
-    PlacedCollider {
-        shape: b.shape,
-        transform: a.transform.lerp(&b.transform, w),
-    }
-}
-
 impl ChainJob<'_> {
     /// Checks sizes and that the inputs are finite.
     pub fn validate(&self) -> Result<()> {
@@ -465,8 +458,7 @@ fn run_fixed(rig: &ChainRig, ci: usize, state: &mut ChainState, component: &Tran
             );
         }
         for &c in &rig.chains[ci].colliders {
-            state.step_colliders[c] =
-                lerp_collider(&state.prev_colliders[c], &state.colliders[c], w);
+            state.step_colliders[c] = state.prev_colliders[c].lerp(&state.colliders[c], w);
         }
         let comp_b = Transform::from_translation_rotation(
             state

@@ -1,0 +1,319 @@
+//! Bone-cloth settings (a `[[cloth]]` table of the rig file): plain data.
+
+use crate::dynamics::Curve;
+use crate::error::{Error, Result};
+use glam::Vec3;
+use serde::{Deserialize, Serialize};
+
+/// Which constraint families a cloth builds (SPCRJointDynamics' switches).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ConstraintSwitches {
+    /// Neighbouring points of one chain.
+    pub structural_vertical: bool,
+    /// Same-index points of neighbouring chains (and last↔first with `loop_chains`).
+    pub structural_horizontal: bool,
+    /// Both diagonals of every quad between neighbouring chains.
+    pub shear: bool,
+    /// Points two apart on one chain.
+    pub bending_vertical: bool,
+    /// Same-index points of chains two apart (wrapping with `loop_chains`).
+    pub bending_horizontal: bool,
+}
+
+impl Default for ConstraintSwitches {
+    fn default() -> Self {
+        Self {
+            structural_vertical: true,
+            structural_horizontal: true,
+            shear: true,
+            bending_vertical: true,
+            bending_horizontal: false,
+        }
+    }
+}
+
+/// One strength curve per constraint family, over the normalised chain position (0 at the
+/// roots, 1 at the tips); values 0..=1 are the share of the length error corrected per
+/// iteration.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct StrengthCurves {
+    /// Structural, along the chains.
+    pub structural_vertical: Curve,
+    /// Structural, across the chains.
+    pub structural_horizontal: Curve,
+    /// Shear (quad diagonals).
+    pub shear: Curve,
+    /// Bending along the chains.
+    pub bending_vertical: Curve,
+    /// Bending across the chains.
+    pub bending_horizontal: Curve,
+}
+
+/// Per-point parameter curves over the normalised chain position; each multiplies its
+/// base value.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct PointCurves {
+    /// Multiplies `resistance`.
+    pub resistance: Curve,
+    /// Multiplies `hardness`.
+    pub hardness: Curve,
+    /// Multiplies `gravity_scale`.
+    pub gravity_scale: Curve,
+    /// Multiplies `drag`.
+    pub drag: Curve,
+    /// Multiplies `lift`.
+    pub lift: Curve,
+    /// Multiplies `radius`.
+    pub radius: Curve,
+}
+
+/// How the cloth's quads meet the colliders.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SurfaceCollision {
+    /// Points (and segments, if on) only.
+    Off,
+    /// A collider closer to a quad than its radius pushes the quad away.
+    Push,
+    /// Push, and a collider that got through a quad pulls the quad back over it: every
+    /// (triangle, collider) pair keeps the side it had when they last met.
+    PushPull,
+}
+
+/// Wind on a cloth.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ClothWind {
+    /// World-space acceleration, m/s².
+    pub acceleration: Vec3,
+    /// Gust amount 0..=1: each point and step scales the wind by a random factor in
+    /// `[1 − gust, 1 + gust]`.
+    pub gust: f32,
+    /// Seed of the gust generator.
+    pub seed: u64,
+}
+
+impl Default for ClothWind {
+    fn default() -> Self {
+        Self {
+            acceleration: Vec3::ZERO,
+            gust: 0.0,
+            seed: 1,
+        }
+    }
+}
+
+/// A mass-spring bone cloth built from parallel bone chains (after SPCRJointDynamics).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ClothSettings {
+    /// A name for messages.
+    pub name: String,
+    /// The chains, in order around or across the cloth: `[root bone, end bone]` pairs; each
+    /// chain is the end bone and its ancestors up to the root bone.
+    pub chains: Vec<[String; 2]>,
+    /// Close the ring: the last chain is the first one's neighbour (a skirt).
+    pub loop_chains: bool,
+    /// Points with index ≤ this on every chain follow the animation (0 = the roots).
+    pub fixed_point_index: u32,
+    /// Length of an extra tip point past each end bone, metres (0 = none).
+    pub virtual_bone_length: f32,
+    /// Constraint families built.
+    pub constraints: ConstraintSwitches,
+    /// Strength against shrinking, per family.
+    pub shrink: StrengthCurves,
+    /// Strength against stretching, per family.
+    pub stretch: StrengthCurves,
+    /// Share of the velocity lost per step, 0..=1.
+    pub resistance: f32,
+    /// Share of the way back to the animated point per step, 0..=1.
+    pub hardness: f32,
+    /// Gravity, m/s² (world space).
+    pub gravity: Vec3,
+    /// Multiplies gravity per point.
+    pub gravity_scale: f32,
+    /// Quadratic air drag, 1/m: speed lost per step is `drag·|v|²·h`.
+    pub drag: f32,
+    /// Lift, 1/s: acceleration `lift·|v|` across the motion, away from gravity.
+    pub lift: f32,
+    /// Wind.
+    pub wind: ClothWind,
+    /// Collision radius of each point, metres.
+    pub radius: f32,
+    /// Share of a point's velocity lost on the step after it touched a collider, 0..=1.
+    pub friction: f32,
+    /// Colliders (rig collider names; empty = all).
+    pub colliders: Vec<String>,
+    /// Also keep the structural segments (not just their points) out of the colliders.
+    pub segment_collision: bool,
+    /// Collision of the quads.
+    pub surface_collision: SurfaceCollision,
+    /// Largest angle, degrees, between a segment and where its parent segment's swing
+    /// takes its animated direction (0 = no limit).
+    pub limit_angle: f32,
+    /// Largest speed of a point, m/s (0 = no limit).
+    pub max_speed: f32,
+    /// After the frame's steps, no chain segment is longer than its rest length.
+    pub force_length_limit: bool,
+    /// Steps per second (SPCRJointDynamics uses 120).
+    pub step_rate: f32,
+    /// At most this many steps per frame; longer hitches drop time.
+    pub max_steps_per_frame: u32,
+    /// Constraint iterations per step.
+    pub iterations: u32,
+    /// Reset when the character moves farther than this in one frame, metres (0 = never).
+    pub teleport_distance: f32,
+    /// Reset when the character turns more than this in one frame, degrees (0 = never).
+    pub teleport_angle: f32,
+    /// Per-point parameter curves.
+    pub curves: PointCurves,
+}
+
+impl Default for ClothSettings {
+    fn default() -> Self {
+        Self {
+            name: String::new(),
+            chains: Vec::new(),
+            loop_chains: false,
+            fixed_point_index: 0,
+            virtual_bone_length: 0.0,
+            constraints: ConstraintSwitches::default(),
+            shrink: StrengthCurves::default(),
+            stretch: StrengthCurves::default(),
+            resistance: 0.05,
+            hardness: 0.0,
+            gravity: Vec3::new(0.0, -9.81, 0.0),
+            gravity_scale: 1.0,
+            drag: 0.0,
+            lift: 0.0,
+            wind: ClothWind::default(),
+            radius: 0.02,
+            friction: 0.3,
+            colliders: Vec::new(),
+            segment_collision: true,
+            surface_collision: SurfaceCollision::PushPull,
+            limit_angle: 0.0,
+            max_speed: 0.0,
+            force_length_limit: true,
+            step_rate: 120.0,
+            max_steps_per_frame: 8,
+            iterations: 4,
+            teleport_distance: 1.0,
+            teleport_angle: 60.0,
+            curves: PointCurves::default(),
+        }
+    }
+}
+
+impl ClothSettings {
+    /// Checks every parameter; errors name the cloth and the parameter.
+    pub fn validate(&self) -> Result<()> {
+        let name = &self.name;
+        let bad = |what: &str, v: String| {
+            Err(Error::InvalidParameter(format!(
+                "cloth '{name}': {what} = {v} is out of range"
+            )))
+        };
+        let unit = |what: &str, v: f32| {
+            if (0.0..=1.0).contains(&v) {
+                Ok(())
+            } else {
+                bad(what, format!("{v} (0..=1)"))
+            }
+        };
+        let non_neg = |what: &str, v: f32| {
+            if v.is_finite() && v >= 0.0 {
+                Ok(())
+            } else {
+                bad(what, format!("{v} (finite, ≥ 0)"))
+            }
+        };
+        if self.chains.len() < 2 {
+            return Err(Error::InvalidParameter(format!(
+                "cloth '{name}': needs at least two chains, has {}",
+                self.chains.len()
+            )));
+        }
+        unit("resistance", self.resistance)?;
+        unit("hardness", self.hardness)?;
+        unit("friction", self.friction)?;
+        unit("wind.gust", self.wind.gust)?;
+        non_neg("virtual_bone_length", self.virtual_bone_length)?;
+        non_neg("drag", self.drag)?;
+        non_neg("lift", self.lift)?;
+        non_neg("radius", self.radius)?;
+        non_neg("limit_angle", self.limit_angle)?;
+        non_neg("max_speed", self.max_speed)?;
+        non_neg("teleport_distance", self.teleport_distance)?;
+        non_neg("teleport_angle", self.teleport_angle)?;
+        if !self.gravity_scale.is_finite() {
+            return bad("gravity_scale", format!("{}", self.gravity_scale));
+        }
+        if !self.gravity.is_finite() {
+            return bad("gravity", format!("{}", self.gravity));
+        }
+        if !self.wind.acceleration.is_finite() {
+            return bad("wind.acceleration", format!("{}", self.wind.acceleration));
+        }
+        if !(self.step_rate.is_finite() && (10.0..=10_000.0).contains(&self.step_rate)) {
+            return bad("step_rate", format!("{} (10..=10000)", self.step_rate));
+        }
+        if !(1..=64).contains(&self.max_steps_per_frame) {
+            return bad(
+                "max_steps_per_frame",
+                format!("{} (1..=64)", self.max_steps_per_frame),
+            );
+        }
+        if !(1..=64).contains(&self.iterations) {
+            return bad("iterations", format!("{} (1..=64)", self.iterations));
+        }
+        for (family, s, t) in [
+            (
+                "structural_vertical",
+                &self.shrink.structural_vertical,
+                &self.stretch.structural_vertical,
+            ),
+            (
+                "structural_horizontal",
+                &self.shrink.structural_horizontal,
+                &self.stretch.structural_horizontal,
+            ),
+            ("shear", &self.shrink.shear, &self.stretch.shear),
+            (
+                "bending_vertical",
+                &self.shrink.bending_vertical,
+                &self.stretch.bending_vertical,
+            ),
+            (
+                "bending_horizontal",
+                &self.shrink.bending_horizontal,
+                &self.stretch.bending_horizontal,
+            ),
+        ] {
+            for (kind, c) in [("shrink", s), ("stretch", t)] {
+                let what = format!("cloth '{name}': {kind}.{family}");
+                c.validate(&what)?;
+                if c.keys.iter().any(|k| !(0.0..=1.0).contains(&k[1])) {
+                    return Err(Error::InvalidParameter(format!(
+                        "{what}: strengths must be within 0..=1"
+                    )));
+                }
+            }
+        }
+        let c = &self.curves;
+        for (what, curve) in [
+            ("resistance", &c.resistance),
+            ("hardness", &c.hardness),
+            ("gravity_scale", &c.gravity_scale),
+            ("drag", &c.drag),
+            ("lift", &c.lift),
+            ("radius", &c.radius),
+        ] {
+            curve.validate(&format!("cloth '{name}': curves.{what}"))?;
+        }
+        Ok(())
+    }
+}
