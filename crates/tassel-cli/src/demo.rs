@@ -30,6 +30,7 @@ fn chain_color(name: &str) -> [u8; 3] {
         "lock" => [210, 170, 0],
         "tail" => [40, 90, 220],
         "skirt" => [200, 40, 160],
+        "charm" => [0, 160, 140],
         "chest" => [220, 30, 30],
         _ => [0, 0, 0],
     }
@@ -72,6 +73,12 @@ pub fn run(a: Args) -> Result<(), String> {
                     }
                 }
             }
+        }
+    }
+    for ri in 0..sim.ropes().len() {
+        let name = sim.ropes().settings(ri).name.clone();
+        for j in sim.ropes().simulated_joints() {
+            group_of[j].get_or_insert_with(|| name.clone());
         }
     }
     // Tips whose distance from their animated place is plotted: chains by name, and the
@@ -264,7 +271,8 @@ pub fn run(a: Args) -> Result<(), String> {
     write_atomic(&glb_path, &glb)?;
     write_atomic(&png_path, &png)?;
     let simulated = sim.chains().point_count() - sim.chains().chain_count()
-        + sim.cloths().simulated_joints().count();
+        + sim.cloths().simulated_joints().count()
+        + sim.ropes().simulated_joints().count();
     println!(
         "tassel demo: idle, walk, run, sudden stop, turn in place, jump ({:.0} s at {} Hz)",
         DemoScript::DURATION,
@@ -272,10 +280,11 @@ pub fn run(a: Args) -> Result<(), String> {
     );
     println!("  frames: {}", frames + 1);
     println!(
-        "  chains: {}, cloths: {} ({} points), springs: {}, joints simulated: {simulated} (of {n}), colliders: {}",
+        "  chains: {}, cloths: {} ({} points), ropes: {}, springs: {}, joints simulated: {simulated} (of {n}), colliders: {}",
         sim.chains().chain_count(),
         sim.cloths().cloth_count(),
         sim.cloths().point_count(),
+        sim.ropes().len(),
         sim.springs().len(),
         sim.chains().collider_count()
     );

@@ -6,6 +6,8 @@ use crate::anim::{Channel, Clip, Interpolation, JointTrack};
 use crate::collide::Shape;
 use crate::dynamics::chain::ChainSettings;
 use crate::dynamics::cloth::ClothSettings;
+use crate::dynamics::particles::ParticleSettings;
+use crate::dynamics::rope::RopeSettings;
 use crate::dynamics::spring::SpringSettings;
 use crate::dynamics::{ColliderSettings, Curve, RigSettings};
 use crate::math::Transform;
@@ -54,6 +56,7 @@ fn skeleton() -> Skeleton {
     for i in 1..6 {
         p = b.add(format!("ponytail_{i}"), Some(p), t(0.0, -0.065, -0.02));
     }
+    let mut hand_l = 0;
     for (side, x) in [("l", 1.0f32), ("r", -1.0)] {
         let mut p = b.add(
             format!("lock_{side}_0"),
@@ -79,11 +82,19 @@ fn skeleton() -> Skeleton {
         );
         let ua = b.add(format!("upper_arm_{side}"), Some(sh), t(0.1 * x, 0.0, 0.0));
         let la = b.add(format!("lower_arm_{side}"), Some(ua), t(0.0, -0.28, 0.0));
-        b.add(format!("hand_{side}"), Some(la), t(0.0, -0.25, 0.0));
+        let hand = b.add(format!("hand_{side}"), Some(la), t(0.0, -0.25, 0.0));
+        if side == "l" {
+            hand_l = hand;
+        }
         let th = b.add(format!("thigh_{side}"), Some(hips), t(0.09 * x, -0.05, 0.0));
         let sh = b.add(format!("shin_{side}"), Some(th), t(0.0, -0.42, 0.0));
         let ft = b.add(format!("foot_{side}"), Some(sh), t(0.0, -0.42, 0.0));
         b.add(format!("toe_{side}"), Some(ft), t(0.0, -0.05, 0.12));
+    }
+    // A tassel on a cord held in the left hand: a rope of particles on five bones.
+    let mut p = b.add("charm_0", Some(hand_l), t(0.0, -0.06, 0.0));
+    for i in 1..5 {
+        p = b.add(format!("charm_{i}"), Some(p), t(0.0, -0.05, 0.0));
     }
     let mut p = b.add("tail_0", Some(hips), t(0.0, 0.0, -0.12));
     for i in 1..8 {
@@ -221,11 +232,30 @@ fn rig() -> RigSettings {
         colliders: names(&["thigh_l", "thigh_r", "shin_l", "shin_r"]),
         ..Default::default()
     }];
+    // The tassel in the left hand: a particle rope, kept out of the left thigh and above
+    // the ground.
+    let ropes = vec![RopeSettings {
+        name: "charm".into(),
+        root: "charm_0".into(),
+        end: "charm_4".into(),
+        mass: 0.05,
+        colliders: names(&["thigh_l"]),
+        ground: Some(0.0),
+        world: ParticleSettings {
+            damping: 0.03,
+            iterations: 8,
+            radius: 0.01,
+            friction: 0.5,
+            ..Default::default()
+        },
+        ..Default::default()
+    }];
     RigSettings {
         chains,
         colliders,
         springs,
         cloths,
+        ropes,
     }
 }
 

@@ -2,6 +2,7 @@
 
 use crate::dynamics::chain::{ChainJob, ChainRig, ChainState};
 use crate::dynamics::cloth::{ClothJob, ClothRig, ClothState};
+use crate::dynamics::rope::Ropes;
 use crate::dynamics::spring::{SpringJob, SpringRig, SpringState};
 use crate::dynamics::RigSettings;
 use crate::error::{Error, Result};
@@ -28,6 +29,7 @@ pub struct CharacterSim {
     spring_state: SpringState,
     cloths: ClothRig,
     cloth_state: ClothState,
+    ropes: Ropes,
     pose: Pose,
     animated_models: Vec<Transform>,
 }
@@ -41,16 +43,29 @@ impl CharacterSim {
         let spring_state = SpringState::new(&springs);
         let cloths = ClothRig::new(&skeleton, rig)?;
         let cloth_state = ClothState::new(&cloths);
-        // One solver per bone: a cloth bone must not also be a chain's or a spring's.
-        for j in cloths.simulated_joints() {
-            let in_chain = (0..chains.point_count()).any(|p| chains.point(p).joint == Some(j));
+        rig.validate_for(&skeleton)?;
+        let ropes = Ropes::new(&skeleton, rig)?;
+        // One solver per bone: a cloth or rope bone must not also be a chain's or a
+        // spring's (or both a cloth's and a rope's).
+        let cloth_joints: Vec<usize> = cloths.simulated_joints().collect();
+        if let Some(j) = ropes.simulated_joints().find(|j| cloth_joints.contains(j)) {
+            return Err(Error::InvalidParameter(format!(
+                "bone '{}' is simulated by a cloth and by a rope",
+                skeleton.name(j)
+            )));
+        }
+        for j in cloths.simulated_joints().chain(ropes.simulated_joints()) {
+            let in_chain = (0..chains.point_count()).any(|p| {
+                let info = chains.point(p);
+                info.joint == Some(j) && info.parent.is_some()
+            });
             let in_spring = rig
                 .springs
                 .iter()
                 .any(|s| skeleton.find(&s.bone) == Some(j));
             if in_chain || in_spring {
                 return Err(Error::InvalidParameter(format!(
-                    "bone '{}' is simulated by a cloth and by a {}",
+                    "bone '{}' is simulated by a cloth or rope and by a {}",
                     skeleton.name(j),
                     if in_chain { "chain" } else { "spring" }
                 )));
@@ -66,6 +81,7 @@ impl CharacterSim {
             spring_state,
             cloths,
             cloth_state,
+            ropes,
             pose,
             animated_models,
         })
@@ -129,6 +145,13 @@ impl CharacterSim {
             }
             .run()?;
         }
+        self.ropes.frame(
+            &self.skeleton,
+            &component,
+            dt,
+            &mut self.pose.locals,
+            &mut self.pose.models,
+        )?;
         Ok(&self.pose)
     }
 
@@ -167,6 +190,11 @@ impl CharacterSim {
         &self.cloth_state
     }
 
+    /// The ropes and their particle worlds.
+    pub fn ropes(&self) -> &Ropes {
+        &self.ropes
+    }
+
     /// The last output pose.
     pub fn pose(&self) -> &Pose {
         &self.pose
@@ -182,5 +210,6 @@ impl CharacterSim {
         self.state.reset();
         self.spring_state.reset();
         self.cloth_state.reset();
+        self.ropes.reset();
     }
 }

@@ -94,6 +94,7 @@ fn pendulum_period_matches_small_angle_formula() {
         colliders: vec![],
         springs: vec![],
         cloths: vec![],
+        ropes: vec![],
     };
     let mut sim = Sim::new(sk, rig);
     // Stiffness 0: the animated pose only sets the start. Record x(t) and find the times
@@ -139,6 +140,7 @@ fn chain_released_horizontally_hangs_straight_down() {
                 colliders: vec![],
                 springs: vec![],
                 cloths: vec![],
+                ropes: vec![],
             },
         );
         let mut pts = Vec::new();
@@ -169,6 +171,7 @@ fn stiffness_one_gives_the_animated_pose() {
                 colliders: vec![],
                 springs: vec![],
                 cloths: vec![],
+                ropes: vec![],
             },
         );
         let rest = Pose::rest(&sk);
@@ -248,6 +251,7 @@ fn points_never_end_a_frame_inside_colliders() {
             colliders: shapes.to_vec(),
             springs: vec![],
             cloths: vec![],
+            ropes: vec![],
         };
         let mut sim = Sim::new(sk, rig);
         let mut worst = f32::MIN;
@@ -294,6 +298,7 @@ fn sway(mode: TimeMode, hz: f32, seconds: f32) -> (Vec<f32>, Vec<Vec3>, Vec<Vec3
             colliders: vec![],
             springs: vec![],
             cloths: vec![],
+            ropes: vec![],
         },
     );
     let rest = Pose::rest(&sk);
@@ -371,6 +376,7 @@ fn bad_time_steps_and_hitches() {
             colliders: vec![],
             springs: vec![],
             cloths: vec![],
+            ropes: vec![],
         },
     );
     let mut locals = sk.rest().to_vec();
@@ -415,6 +421,7 @@ fn same_inputs_same_bits() {
                 colliders: vec![],
                 springs: vec![],
                 cloths: vec![],
+                ropes: vec![],
             },
         );
         let mut bits = Vec::new();
@@ -444,6 +451,7 @@ fn wind_pushes_the_chain_downwind() {
             colliders: vec![],
             springs: vec![],
             cloths: vec![],
+            ropes: vec![],
         },
     );
     let mut pts = Vec::new();
@@ -468,6 +476,7 @@ fn alpha_warmup_and_turn_teleport() {
             colliders: vec![],
             springs: vec![],
             cloths: vec![],
+            ropes: vec![],
         },
     );
     let rest = Pose::rest(&sk);
@@ -488,6 +497,7 @@ fn alpha_warmup_and_turn_teleport() {
             colliders: vec![],
             springs: vec![],
             cloths: vec![],
+            ropes: vec![],
         },
     );
     let pts = sim.frame(Transform::IDENTITY, 0.0);
@@ -504,6 +514,7 @@ fn alpha_warmup_and_turn_teleport() {
             colliders: vec![],
             springs: vec![],
             cloths: vec![],
+            ropes: vec![],
         },
     );
     for _ in 0..20 {

@@ -309,3 +309,135 @@ fn a_huge_time_step_is_capped_and_stays_finite() {
         "fell too far in one capped call"
     );
 }
+
+#[test]
+fn charm_rope_follows_the_hand_keeps_its_bones_on_the_particles_and_stays_out_of_the_thigh() {
+    use tassel::builtin::{self, DemoScript};
+    use tassel::CharacterSim;
+    let c = builtin::character();
+    let sk = &c.skeleton;
+    let mut sim = CharacterSim::new(sk.clone(), &c.rig).unwrap();
+    let script = DemoScript;
+    let mut animator = script.animator(&c);
+    let mut locals = sk.rest().to_vec();
+    let bones: Vec<usize> = (0..5)
+        .map(|i| sk.find(&format!("charm_{i}")).unwrap())
+        .collect();
+    let thigh = c
+        .rig
+        .colliders
+        .iter()
+        .position(|col| col.name == "thigh_l")
+        .unwrap();
+    let dt = 1.0 / 60.0;
+    let (mut worst_bone, mut worst_inside, mut swing) = (0.0_f32, 0.0_f32, 0.0_f32);
+    for f in 0..=600 {
+        let m = script.at(f as f32 * dt);
+        let step = if f == 0 { 0.0 } else { dt };
+        script
+            .pose(&c, &mut animator, &m, step, &mut locals)
+            .unwrap();
+        let animated_tip = {
+            let mut pose = tassel::Pose::rest(sk);
+            pose.locals.copy_from_slice(&locals);
+            tassel::LocalToModelJob {
+                skeleton: sk,
+                root: Transform::IDENTITY,
+                locals: &pose.locals,
+                models: &mut pose.models,
+            }
+            .run()
+            .unwrap();
+            m.component
+                .transform_point(pose.models[bones[4]].translation)
+        };
+        sim.frame(&locals, m.component, step).unwrap();
+        let pose = sim.pose();
+        let world = sim.ropes().world(0);
+        // The written-back bones lie along the particles' directions with their rest
+        // lengths, so bone k is off particle k by at most the sum of the stick length
+        // errors before it (collisions can stretch a stick when the rope is wedged).
+        let mut allowed = 1e-4;
+        for (k, &b) in bones.iter().enumerate() {
+            if k > 0 {
+                let s = world.sticks()[k - 1];
+                allowed += ((world.position(s.a) - world.position(s.b)).length() - s.length).abs();
+            }
+            let bone = m.component.transform_point(pose.models[b].translation);
+            let e = (bone - world.position(k)).length();
+            assert!(
+                e <= allowed,
+                "frame {f}: charm_{k} is {e} m off its particle (allowed {allowed})"
+            );
+            worst_bone = worst_bone.max(e);
+        }
+        let placed = &world.colliders[0];
+        assert_eq!(placed.shape, c.rig.colliders[thigh].shape);
+        for p in world.positions() {
+            worst_inside = worst_inside.max(placed.penetration(*p, 0.0));
+            assert!(p.y > -1e-4, "below the ground: {p}");
+        }
+        swing = swing.max((world.position(4) - animated_tip).length());
+    }
+    println!("charm: bones at most {worst_bone:.5} m off the particles, worst thigh penetration {worst_inside:.5} m, largest swing {swing:.3} m");
+    assert!(worst_inside <= 1e-3, "{worst_inside} m inside the thigh");
+    assert!(swing > 0.02, "the rope never swung: {swing} m");
+}
+
+#[test]
+fn rope_on_a_tilted_bone_settles_hanging_straight_down() {
+    use tassel::dynamics::rope::RopeSettings;
+    use tassel::dynamics::RigSettings;
+    use tassel::{CharacterSim, SkeletonBuilder};
+    let mut b = SkeletonBuilder::new();
+    let root = b.add(
+        "root",
+        None,
+        Transform::from_translation(Vec3::new(0.0, 2.0, 0.0)),
+    );
+    // The rope starts sideways along +X.
+    let mut p = b.add("r0", Some(root), Transform::IDENTITY);
+    for i in 1..5 {
+        p = b.add(
+            format!("r{i}"),
+            Some(p),
+            Transform::from_translation(Vec3::new(0.1, 0.0, 0.0)),
+        );
+    }
+    let sk = b.build().unwrap().0;
+    let rig = RigSettings {
+        ropes: vec![RopeSettings {
+            name: "r".into(),
+            root: "r0".into(),
+            end: "r4".into(),
+            ..Default::default()
+        }],
+        ..Default::default()
+    };
+    let mut sim = CharacterSim::new(sk.clone(), &rig).unwrap();
+    let rest = sk.rest().to_vec();
+    for _ in 0..1200 {
+        sim.frame(&rest, Transform::IDENTITY, 1.0 / 60.0).unwrap();
+    }
+    let pose = sim.pose();
+    for i in 1..5 {
+        let j = sk.find(&format!("r{i}")).unwrap();
+        let expected = Vec3::new(0.0, 2.0 - 0.1 * i as f32, 0.0);
+        let got = pose.models[j].translation;
+        assert!(
+            (got - expected).length() < 2e-3,
+            "r{i} at {got}, expected {expected}"
+        );
+    }
+    // A bone on a rope and a chain at once is refused.
+    let mut both = rig.clone();
+    both.chains.push(tassel::dynamics::chain::ChainSettings {
+        name: "c".into(),
+        root: "r2".into(),
+        ..Default::default()
+    });
+    let e = CharacterSim::new(sk.clone(), &both)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("'r3'"), "{e}");
+}

@@ -1,12 +1,14 @@
 //! Secondary motion solvers: `chain`, the KawaiiPhysics-style bone chain (seed 000);
 //! `spring`, Unreal's spring controller (seed 002); `cloth`, SPCRJointDynamics' bone cloth
-//! (seed 004); `particles`, a general Verlet particle-constraint world (seed 001).
+//! (seed 004); `particles`, a general Verlet particle-constraint world (seed 001), and
+//! `rope`, bone chains driven by it.
 
 pub mod chain;
 pub mod cloth;
 mod curve;
 pub mod particles;
 mod rig;
+pub mod rope;
 pub mod spring;
 
 pub use curve::Curve;

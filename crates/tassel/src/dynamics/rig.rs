@@ -4,6 +4,7 @@
 use crate::collide::Shape;
 use crate::dynamics::chain::ChainSettings;
 use crate::dynamics::cloth::ClothSettings;
+use crate::dynamics::rope::RopeSettings;
 use crate::dynamics::spring::SpringSettings;
 use crate::error::{Error, Result};
 use crate::skeleton::Skeleton;
@@ -50,6 +51,9 @@ pub struct RigSettings {
     /// Bone cloths (`[[cloth]]` tables).
     #[serde(default, rename = "cloth")]
     pub cloths: Vec<ClothSettings>,
+    /// Ropes on bones driven by the particle world (`[[rope]]` tables).
+    #[serde(default, rename = "rope")]
+    pub ropes: Vec<RopeSettings>,
 }
 
 impl RigSettings {
@@ -73,6 +77,17 @@ impl RigSettings {
         }
         for s in &self.springs {
             s.validate()?;
+        }
+        for r in &self.ropes {
+            r.validate()?;
+            for name in &r.colliders {
+                if !self.colliders.iter().any(|o| &o.name == name) {
+                    return Err(Error::InvalidParameter(format!(
+                        "rope '{}' names collider '{name}', which the rig does not define",
+                        r.name
+                    )));
+                }
+            }
         }
         for (i, c) in self.cloths.iter().enumerate() {
             c.validate()?;
@@ -143,6 +158,10 @@ impl RigSettings {
         }
         for s in &self.springs {
             need(format!("spring '{}' bone", s.name), &s.bone)?;
+        }
+        for r in &self.ropes {
+            need(format!("rope '{}' root", r.name), &r.root)?;
+            need(format!("rope '{}' end", r.name), &r.end)?;
         }
         for c in &self.cloths {
             for [root, end] in &c.chains {
