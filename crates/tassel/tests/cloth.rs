@@ -437,3 +437,88 @@ fn bad_cloth_settings_are_errors_naming_the_problem() {
         .to_string();
     assert!(e.contains("skirt_0_"), "{e}");
 }
+
+fn hanging(f: &dyn Fn(&mut ClothSettings)) -> Rig {
+    // 5 chains of 5 bones hanging straight down from a row along X.
+    let (sk, pairs) = sheet(5, 5, 0.1, Vec3::NEG_Y);
+    let mut s = ClothSettings {
+        name: "sheet".into(),
+        chains: pairs,
+        resistance: 0.05,
+        ..Default::default()
+    };
+    f(&mut s);
+    Rig::new(
+        sk,
+        RigSettings {
+            cloths: vec![s],
+            ..Default::default()
+        },
+    )
+}
+
+#[test]
+fn hardness_one_gives_the_animated_pose() {
+    let mut r = hanging(&|s| {
+        s.hardness = 1.0;
+        s.wind.acceleration = Vec3::new(0.0, 0.0, 5.0);
+    });
+    let rest = r.sk.rest().to_vec();
+    let animated = Pose::rest(&r.sk);
+    for _ in 0..60 {
+        r.frame(&rest, 1.0 / 60.0);
+    }
+    for c in 0..5 {
+        for i in 0..5 {
+            let j = r.sk.find(&format!("c{c}_{i}")).unwrap();
+            let got = r.state.world_positions()[c * 5 + i];
+            assert!(
+                (got - animated.models[j].translation).length() < 1e-5,
+                "{got}"
+            );
+        }
+    }
+}
+
+#[test]
+fn steady_wind_tilts_the_sheet_to_atan_wind_over_g() {
+    // Wind across the sheet and gravity: at rest every chain lies along their sum, which
+    // the constraints allow (a rigid turn about the pinned row).
+    let wind = 4.0_f32;
+    let mut r = hanging(&|s| s.wind.acceleration = Vec3::new(0.0, 0.0, wind));
+    let rest = r.sk.rest().to_vec();
+    for _ in 0..1200 {
+        r.frame(&rest, 1.0 / 60.0);
+    }
+    let expected = wind.atan2(9.81);
+    let pos = r.state.world_positions();
+    for c in 0..5 {
+        let d = pos[c * 5 + 4] - pos[c * 5];
+        let angle = d.z.atan2(-d.y);
+        assert!(
+            (angle - expected).abs() < 0.01,
+            "chain {c} at {angle}, expected {expected}"
+        );
+    }
+}
+
+#[test]
+fn angle_limit_holds_against_strong_wind() {
+    let mut r = hanging(&|s| {
+        s.wind.acceleration = Vec3::new(0.0, 0.0, 30.0);
+        s.limit_angle = 10.0;
+    });
+    let rest = r.sk.rest().to_vec();
+    for _ in 0..300 {
+        r.frame(&rest, 1.0 / 60.0);
+    }
+    // The first free segment may turn at most 10° from its animated (straight down)
+    // direction; with no limit the wind would blow it to atan(30 / 9.81) ≈ 72°.
+    let pos = r.state.world_positions();
+    for c in 0..5 {
+        let d = pos[c * 5 + 1] - pos[c * 5];
+        let angle = d.angle_between(Vec3::NEG_Y).to_degrees();
+        assert!(angle <= 10.0 + 0.5, "chain {c}: {angle}°");
+        assert!(angle > 5.0, "the wind should lean on the limit: {angle}°");
+    }
+}

@@ -78,6 +78,7 @@ pub struct ClothRig {
     pub(crate) drag: Vec<f32>,
     pub(crate) lift: Vec<f32>,
     pub(crate) radius: Vec<f32>,
+    pub(crate) friction: Vec<f32>,
     pub(crate) constraints: Vec<ClothConstraint>,
 }
 
@@ -172,6 +173,8 @@ impl ClothRig {
                     out.drag.push((s.drag * c.drag.eval(x)).max(0.0));
                     out.lift.push((s.lift * c.lift.eval(x)).max(0.0));
                     out.radius.push((s.radius * c.radius.eval(x)).max(0.0));
+                    out.friction
+                        .push((s.friction * c.friction.eval(x)).clamp(0.0, 1.0));
                 }
             }
             // Rest positions for the rest lengths.

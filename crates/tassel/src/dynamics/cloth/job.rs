@@ -426,7 +426,7 @@ fn collide(
                 pos[p] = after;
                 touched = true;
                 if let Some((friction, _)) = contact.as_mut() {
-                    friction[p] = s.friction;
+                    friction[p] = rig.friction[p];
                 }
             }
         }

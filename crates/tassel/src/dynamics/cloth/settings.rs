@@ -68,6 +68,8 @@ pub struct PointCurves {
     pub lift: Curve,
     /// Multiplies `radius`.
     pub radius: Curve,
+    /// Multiplies `friction`.
+    pub friction: Curve,
 }
 
 /// How the cloth's quads meet the colliders.
@@ -311,6 +313,7 @@ impl ClothSettings {
             ("drag", &c.drag),
             ("lift", &c.lift),
             ("radius", &c.radius),
+            ("friction", &c.friction),
         ] {
             curve.validate(&format!("cloth '{name}': curves.{what}"))?;
         }
