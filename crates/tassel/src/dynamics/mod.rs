@@ -12,4 +12,5 @@ pub mod rope;
 pub mod spring;
 
 pub use curve::Curve;
+pub(crate) use rig::CompiledCollider;
 pub use rig::{ColliderSettings, RigSettings};

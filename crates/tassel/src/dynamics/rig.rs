@@ -1,12 +1,13 @@
 //! The rig file: chains and colliders attached to a skeleton by bone names (TOML; see
 //! docs/rig.md).
 
-use crate::collide::Shape;
+use crate::collide::{PlacedCollider, Shape};
 use crate::dynamics::chain::ChainSettings;
 use crate::dynamics::cloth::ClothSettings;
 use crate::dynamics::rope::RopeSettings;
 use crate::dynamics::spring::SpringSettings;
 use crate::error::{Error, Result};
+use crate::math::Transform;
 use crate::skeleton::Skeleton;
 use glam::{Quat, Vec3};
 use serde::{Deserialize, Serialize};
@@ -33,6 +34,41 @@ pub struct ColliderSettings {
 
 fn identity() -> Quat {
     Quat::IDENTITY
+}
+
+/// A rig collider with its bone resolved: what every solver places each frame.
+#[derive(Debug, Clone)]
+pub(crate) struct CompiledCollider {
+    pub bone: usize,
+    pub offset: Transform,
+    pub shape: Shape,
+}
+
+impl CompiledCollider {
+    /// Every collider of `rig` (bone names must have been checked).
+    pub fn compile_all(skeleton: &Skeleton, rig: &RigSettings) -> Vec<Self> {
+        rig.colliders
+            .iter()
+            .map(|c| CompiledCollider {
+                bone: skeleton.find(&c.bone).unwrap_or(0),
+                offset: Transform::from_translation_rotation(c.offset, c.rotation.normalize()),
+                shape: c.shape,
+            })
+            .collect()
+    }
+
+    /// Where it is for the model pose `models`, seen from `frame` (identity: model
+    /// space; the character's transform: world space). Scale is ignored.
+    pub fn place(&self, models: &[Transform], frame: &Transform) -> PlacedCollider {
+        let bone = &models[self.bone];
+        let t = *frame
+            * Transform::from_translation_rotation(bone.translation, bone.rotation)
+            * self.offset;
+        PlacedCollider {
+            shape: self.shape,
+            transform: Transform::from_translation_rotation(t.translation, t.rotation),
+        }
+    }
 }
 
 /// Everything a rig file holds.

@@ -3,9 +3,8 @@
 //! tied to its parent by a stick; ground and body colliders act on them; the bones turn
 //! toward the simulated particles. A `[[rope]]` table of the rig file.
 
-use crate::collide::{PlacedCollider, Shape};
 use crate::dynamics::particles::{ParticleSettings, ParticleWorld};
-use crate::dynamics::RigSettings;
+use crate::dynamics::{CompiledCollider, RigSettings};
 use crate::error::{Error, Result};
 use crate::math::{rotation_arc, Transform};
 use crate::skeleton::Skeleton;
@@ -85,7 +84,7 @@ struct CompiledRope {
     settings: RopeSettings,
     /// Bones from the root down.
     bones: Vec<usize>,
-    colliders: Vec<(usize, Transform, Shape)>,
+    colliders: Vec<CompiledCollider>,
 }
 
 /// Every rope of a rig with its particle world: compile once per character.
@@ -102,6 +101,10 @@ impl Ropes {
     /// Compiles the `[[rope]]` tables of `rig` for `skeleton`.
     pub fn new(skeleton: &Skeleton, rig: &RigSettings) -> Result<Self> {
         let mut out = Ropes::default();
+        if rig.ropes.is_empty() {
+            return Ok(out);
+        }
+        rig.validate_for(skeleton)?;
         for s in &rig.ropes {
             s.validate()?;
             let missing = |n: &str| Error::MissingBone {
@@ -128,18 +131,12 @@ impl Ropes {
                     s.name
                 )));
             }
-            let mut colliders = Vec::new();
-            for c in &rig.colliders {
-                if s.colliders.is_empty() || s.colliders.contains(&c.name) {
-                    let bone = skeleton.find(&c.bone).ok_or_else(|| Error::MissingBone {
-                        context: format!("collider '{}'", c.name),
-                        name: c.bone.clone(),
-                    })?;
-                    let offset =
-                        Transform::from_translation_rotation(c.offset, c.rotation.normalize());
-                    colliders.push((bone, offset, c.shape));
-                }
-            }
+            let colliders: Vec<CompiledCollider> = CompiledCollider::compile_all(skeleton, rig)
+                .into_iter()
+                .zip(&rig.colliders)
+                .filter(|(_, c)| s.colliders.is_empty() || s.colliders.contains(&c.name))
+                .map(|(compiled, _)| compiled)
+                .collect();
             if let Some(missing) = s
                 .colliders
                 .iter()
@@ -238,15 +235,8 @@ impl Ropes {
                 self.fresh[i] = false;
             }
             world.colliders.clear();
-            for (bone, offset, shape) in &rope.colliders {
-                let b = &models[*bone];
-                let t = frame
-                    * Transform::from_translation_rotation(b.translation, b.rotation)
-                    * *offset;
-                world.colliders.push(PlacedCollider {
-                    shape: *shape,
-                    transform: Transform::from_translation_rotation(t.translation, t.rotation),
-                });
+            for c in &rope.colliders {
+                world.colliders.push(c.place(models, &frame));
             }
             if let Some(h) = s.ground {
                 world.add_ground(h);

@@ -1,10 +1,8 @@
 //! Compiling rig settings against a skeleton into flat, structure-of-arrays point data.
 
 use super::settings::ChainSettings;
-use crate::collide::Shape;
-use crate::dynamics::RigSettings;
+use crate::dynamics::{CompiledCollider, RigSettings};
 use crate::error::{Error, Result};
-use crate::math::Transform;
 use crate::pose::Pose;
 use crate::skeleton::Skeleton;
 use std::ops::Range;
@@ -30,13 +28,6 @@ pub(crate) struct CompiledChain {
     pub settings: ChainSettings,
     pub points: Range<usize>,
     pub colliders: Vec<usize>,
-}
-
-#[derive(Debug, Clone)]
-pub(crate) struct CompiledCollider {
-    pub bone: usize,
-    pub offset: Transform,
-    pub shape: Shape,
 }
 
 /// Chains and colliders compiled against one skeleton. Immutable; share it between every
@@ -85,13 +76,7 @@ impl ChainRig {
             rotator_children: Vec::new(),
             joint_count: skeleton.len(),
         };
-        for c in &rig.colliders {
-            out.colliders.push(CompiledCollider {
-                bone: skeleton.find(&c.bone).unwrap_or(0),
-                offset: Transform::from_translation_rotation(c.offset, c.rotation.normalize()),
-                shape: c.shape,
-            });
-        }
+        out.colliders = CompiledCollider::compile_all(skeleton, rig);
         let mut owner: Vec<Option<usize>> = vec![None; skeleton.len()];
         for (ci, settings) in rig.chains.iter().enumerate() {
             let root = skeleton.find(&settings.root).unwrap_or(0);

@@ -250,12 +250,7 @@ fn gather_targets(
         }
     }
     for (placed, c) in colliders.iter_mut().zip(&rig.colliders) {
-        let bone = &models[c.bone];
-        let t = Transform::from_translation_rotation(bone.translation, bone.rotation) * c.offset;
-        *placed = PlacedCollider {
-            shape: c.shape,
-            transform: Transform::from_translation_rotation(t.translation, t.rotation),
-        };
+        *placed = c.place(models, &Transform::IDENTITY);
     }
 }
 

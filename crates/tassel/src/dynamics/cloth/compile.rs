@@ -1,10 +1,8 @@
 //! Compiling `[[cloth]]` settings against a skeleton: points, constraints, quads.
 
 use super::settings::{ClothSettings, StrengthCurves};
-use crate::collide::Shape;
-use crate::dynamics::RigSettings;
+use crate::dynamics::{CompiledCollider, RigSettings};
 use crate::error::{Error, Result};
-use crate::math::Transform;
 use crate::skeleton::Skeleton;
 use std::ops::Range;
 
@@ -53,13 +51,6 @@ pub(crate) struct CompiledCloth {
     pub colliders: Vec<usize>,
 }
 
-#[derive(Debug, Clone)]
-pub(crate) struct CompiledCollider {
-    pub bone: usize,
-    pub offset: Transform,
-    pub shape: Shape,
-}
-
 /// Every `[[cloth]]` of a rig compiled for one skeleton. Immutable: share it between the
 /// characters that use the same skeleton and rig.
 #[derive(Debug, Clone, Default)]
@@ -90,13 +81,7 @@ impl ClothRig {
         if rig.cloths.is_empty() {
             return Ok(out);
         }
-        for c in &rig.colliders {
-            out.colliders.push(CompiledCollider {
-                bone: skeleton.find(&c.bone).unwrap_or(0),
-                offset: Transform::from_translation_rotation(c.offset, c.rotation.normalize()),
-                shape: c.shape,
-            });
-        }
+        out.colliders = CompiledCollider::compile_all(skeleton, rig);
         let rest = crate::pose::Pose::rest(skeleton);
         let mut owner: Vec<Option<usize>> = vec![None; skeleton.len()];
         for (ci, s) in rig.cloths.iter().enumerate() {

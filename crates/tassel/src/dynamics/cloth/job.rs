@@ -196,14 +196,7 @@ fn gather(rig: &ClothRig, models: &[Transform], component: &Transform, state: &m
     }
     let frame = Transform::from_translation_rotation(component.translation, component.rotation);
     for (placed, c) in state.colliders.iter_mut().zip(&rig.colliders) {
-        let bone = &models[c.bone];
-        let t = frame
-            * Transform::from_translation_rotation(bone.translation, bone.rotation)
-            * c.offset;
-        *placed = PlacedCollider {
-            shape: c.shape,
-            transform: Transform::from_translation_rotation(t.translation, t.rotation),
-        };
+        *placed = c.place(models, &frame);
     }
 }
 
