@@ -39,17 +39,17 @@ pub fn run(a: Args) -> Result<(), String> {
     }
     samples.sort_by(|x, y| x.total_cmp(y));
     let median = samples[samples.len() / 2];
-    println!("tassel bench: {chains} chains x {joints} joints, {colliders} colliders, fixed mode 60 Hz, one step per frame, single thread");
-    println!(
+    say!("tassel bench: {chains} chains x {joints} joints, {colliders} colliders, fixed mode 60 Hz, one step per frame, single thread");
+    say!(
         "  {simulated} simulated joints; median of {} runs x {} frames",
         samples.len(),
         a.frames
     );
-    println!(
+    say!(
         "  {median:.1} ns per joint-step (frame incl. pose jobs and write-back: {:.2} us)",
         median * simulated as f64 / 1000.0
     );
-    println!(
+    say!(
         "  min {:.1}  max {:.1} ns per joint-step",
         samples[0],
         samples[samples.len() - 1]

@@ -273,13 +273,13 @@ pub fn run(a: Args) -> Result<(), String> {
     let simulated = sim.chains().point_count() - sim.chains().chain_count()
         + sim.cloths().simulated_joints().count()
         + sim.ropes().simulated_joints().count();
-    println!(
+    say!(
         "tassel demo: idle, walk, run, sudden stop, turn in place, jump ({:.0} s at {} Hz)",
         DemoScript::DURATION,
         a.fps
     );
-    println!("  frames: {}", frames + 1);
-    println!(
+    say!("  frames: {}", frames + 1);
+    say!(
         "  chains: {}, cloths: {} ({} points), ropes: {}, springs: {}, joints simulated: {simulated} (of {n}), colliders: {}",
         sim.chains().chain_count(),
         sim.cloths().cloth_count(),
@@ -288,17 +288,17 @@ pub fn run(a: Args) -> Result<(), String> {
         sim.springs().len(),
         sim.chains().collider_count()
     );
-    println!(
+    say!(
         "  time per frame (secondary motion incl. pose jobs): {:.1} us",
         sim_time * 1e6 / (frames + 1) as f64
     );
-    println!(
+    say!(
         "  teleport resets: {} (chains), {} (cloths)",
         sim.state().teleport_count(),
         sim.cloth_state().reset_count()
     );
-    println!("  states: {} ({events} events)", visited.join(" > "));
-    println!(
+    say!("  states: {} ({events} events)", visited.join(" > "));
+    say!(
         "  wrote {} ({} bytes) and {} ({} bytes)",
         glb_path.display(),
         glb.len(),

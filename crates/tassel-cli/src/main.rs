@@ -1,6 +1,15 @@
 //! The `tassel` command: `demo`, `simulate`, `sample`, `bench`. Argument parsing, files and printing
 //! only; the work is in the `tassel` and `tassel-gltf` crates.
 
+/// `println!` that ignores a closed standard output (`tassel demo | head` must not panic
+/// on the broken pipe; the files are already written when the summary is printed).
+macro_rules! say {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stdout(), $($arg)*);
+    }};
+}
+
 mod bench;
 mod demo;
 mod output;

@@ -151,7 +151,7 @@ pub fn run(a: Args) -> Result<(), String> {
         &a.out,
         &serde_json::to_vec(&doc).map_err(|e| e.to_string())?,
     )?;
-    println!(
+    say!(
         "wrote {} ({} nodes, {} times)",
         a.out.display(),
         n,

@@ -228,7 +228,7 @@ pub fn run(a: Args) -> Result<(), String> {
     });
     let text = serde_json::to_vec(&doc).map_err(|e| e.to_string())?;
     write_atomic(&a.out, &text)?;
-    println!(
+    say!(
         "wrote {} ({} joints, {} frames, mode {mode_name})",
         a.out.display(),
         joints.len(),

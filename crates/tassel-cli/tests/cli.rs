@@ -334,3 +334,23 @@ fn sample_prints_hand_checkable_values() {
     assert!(String::from_utf8_lossy(&o.stderr).contains("Dance"));
     assert!(!bad.exists());
 }
+
+#[test]
+fn a_closed_stdout_is_not_a_panic() {
+    // `tassel demo | head -0`: the reader is gone before the summary is printed.
+    let dir = std::env::temp_dir().join(format!("tassel-pipe-{}", std::process::id()));
+    let mut child = tassel()
+        .args(["demo", "--out"])
+        .arg(&dir)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "exit {:?}: {err}", out.status);
+    assert!(!err.contains("panicked"), "{err}");
+    assert!(dir.join("demo.glb").exists() && dir.join("demo.png").exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}
