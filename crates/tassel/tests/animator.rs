@@ -2,29 +2,15 @@
 //! the pose and reported as a blended delta.
 
 use glam::Vec3;
-use tassel::anim::{Animator, Channel, Clip, Interpolation, JointTrack, RootMotion, StateMachine};
+use tassel::anim::{Animator, Clip, RootMotion, StateMachine};
 use tassel::Transform;
 
 fn mover(name: &str, speed: f32, duration: f32) -> Clip {
-    let times: Vec<f32> = (0..=10).map(|k| k as f32 * duration / 10.0).collect();
-    let values = times
-        .iter()
-        .map(|&t| Vec3::new(0.0, 1.0, speed * t))
-        .collect();
-    Clip {
-        name: name.into(),
-        duration,
-        tracks: vec![JointTrack {
-            joint: 0,
-            translation: Some(Channel {
-                interpolation: Interpolation::Linear,
-                times,
-                values,
-            }),
-            rotation: None,
-            scale: None,
-        }],
-    }
+    let keys = (0..=10).map(|k| {
+        let t = k as f32 * duration / 10.0;
+        (t, Vec3::new(0.0, 1.0, speed * t))
+    });
+    Clip::linear_translation(name, duration, 0, keys)
 }
 
 #[test]

@@ -91,10 +91,7 @@ fn pendulum_period_matches_small_angle_formula() {
     let sk = line_skeleton(1, l, dir);
     let rig = RigSettings {
         chains: vec![free(TimeMode::Fixed, 600.0)],
-        colliders: vec![],
-        springs: vec![],
-        cloths: vec![],
-        ropes: vec![],
+        ..Default::default()
     };
     let mut sim = Sim::new(sk, rig);
     // Stiffness 0: the animated pose only sets the start. Record x(t) and find the times
@@ -137,10 +134,7 @@ fn chain_released_horizontally_hangs_straight_down() {
             sk,
             RigSettings {
                 chains: vec![s],
-                colliders: vec![],
-                springs: vec![],
-                cloths: vec![],
-                ropes: vec![],
+                ..Default::default()
             },
         );
         let mut pts = Vec::new();
@@ -168,10 +162,7 @@ fn stiffness_one_gives_the_animated_pose() {
             sk.clone(),
             RigSettings {
                 chains: vec![s],
-                colliders: vec![],
-                springs: vec![],
-                cloths: vec![],
-                ropes: vec![],
+                ..Default::default()
             },
         );
         let rest = Pose::rest(&sk);
@@ -249,9 +240,7 @@ fn points_never_end_a_frame_inside_colliders() {
         let rig = RigSettings {
             chains: vec![s],
             colliders: shapes.to_vec(),
-            springs: vec![],
-            cloths: vec![],
-            ropes: vec![],
+            ..Default::default()
         };
         let mut sim = Sim::new(sk, rig);
         let mut worst = f32::MIN;
@@ -295,10 +284,7 @@ fn sway(mode: TimeMode, hz: f32, seconds: f32) -> (Vec<f32>, Vec<Vec3>, Vec<Vec3
         sk.clone(),
         RigSettings {
             chains: vec![s],
-            colliders: vec![],
-            springs: vec![],
-            cloths: vec![],
-            ropes: vec![],
+            ..Default::default()
         },
     );
     let rest = Pose::rest(&sk);
@@ -373,10 +359,7 @@ fn bad_time_steps_and_hitches() {
         sk.clone(),
         RigSettings {
             chains: vec![free(TimeMode::Fixed, 60.0)],
-            colliders: vec![],
-            springs: vec![],
-            cloths: vec![],
-            ropes: vec![],
+            ..Default::default()
         },
     );
     let mut locals = sk.rest().to_vec();
@@ -418,10 +401,7 @@ fn same_inputs_same_bits() {
             sk,
             RigSettings {
                 chains: vec![s],
-                colliders: vec![],
-                springs: vec![],
-                cloths: vec![],
-                ropes: vec![],
+                ..Default::default()
             },
         );
         let mut bits = Vec::new();
@@ -448,10 +428,7 @@ fn wind_pushes_the_chain_downwind() {
         sk,
         RigSettings {
             chains: vec![s],
-            colliders: vec![],
-            springs: vec![],
-            cloths: vec![],
-            ropes: vec![],
+            ..Default::default()
         },
     );
     let mut pts = Vec::new();
@@ -473,10 +450,7 @@ fn alpha_warmup_and_turn_teleport() {
         sk.clone(),
         RigSettings {
             chains: vec![s],
-            colliders: vec![],
-            springs: vec![],
-            cloths: vec![],
-            ropes: vec![],
+            ..Default::default()
         },
     );
     let rest = Pose::rest(&sk);
@@ -494,10 +468,7 @@ fn alpha_warmup_and_turn_teleport() {
         sk.clone(),
         RigSettings {
             chains: vec![s],
-            colliders: vec![],
-            springs: vec![],
-            cloths: vec![],
-            ropes: vec![],
+            ..Default::default()
         },
     );
     let pts = sim.frame(Transform::IDENTITY, 0.0);
@@ -511,10 +482,7 @@ fn alpha_warmup_and_turn_teleport() {
         sk.clone(),
         RigSettings {
             chains: vec![free(TimeMode::Fixed, 60.0)],
-            colliders: vec![],
-            springs: vec![],
-            cloths: vec![],
-            ropes: vec![],
+            ..Default::default()
         },
     );
     for _ in 0..20 {

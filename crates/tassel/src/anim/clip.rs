@@ -171,6 +171,31 @@ pub struct Clip {
 }
 
 impl Clip {
+    /// A clip that moves one joint's translation through LINEAR `keys` (`(time, value)`),
+    /// lasting `duration` seconds: a root that walks, a test ramp.
+    pub fn linear_translation(
+        name: &str,
+        duration: f32,
+        joint: usize,
+        keys: impl IntoIterator<Item = (f32, Vec3)>,
+    ) -> Clip {
+        let (times, values) = keys.into_iter().unzip();
+        Clip {
+            name: name.into(),
+            duration,
+            tracks: vec![JointTrack {
+                joint,
+                translation: Some(Channel {
+                    interpolation: Interpolation::Linear,
+                    times,
+                    values,
+                }),
+                rotation: None,
+                scale: None,
+            }],
+        }
+    }
+
     /// Overwrites the animated properties of `locals` with their values at `t` seconds
     /// (clamped to the clip). Properties the clip does not animate are left as they are.
     pub fn sample(&self, t: f32, locals: &mut [Transform]) {

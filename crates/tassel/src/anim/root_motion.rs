@@ -71,29 +71,14 @@ impl RootMotion {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::anim::{Channel, Interpolation, JointTrack};
 
     fn walker(name: &str, speed: f32, duration: f32) -> Clip {
         // The root moves forward at `speed` and bobs 5 cm up and down.
-        let times: Vec<f32> = (0..=20).map(|k| k as f32 * duration / 20.0).collect();
-        let values = times
-            .iter()
-            .map(|&t| Vec3::new(0.0, 0.9 + 0.05 * (t * 10.0).sin(), speed * t))
-            .collect();
-        Clip {
-            name: name.into(),
-            duration,
-            tracks: vec![JointTrack {
-                joint: 0,
-                translation: Some(Channel {
-                    interpolation: Interpolation::Linear,
-                    times,
-                    values,
-                }),
-                rotation: None,
-                scale: None,
-            }],
-        }
+        let keys = (0..=20).map(|k| {
+            let t = k as f32 * duration / 20.0;
+            (t, Vec3::new(0.0, 0.9 + 0.05 * (t * 10.0).sin(), speed * t))
+        });
+        Clip::linear_translation(name, duration, 0, keys)
     }
 
     #[test]

@@ -113,27 +113,12 @@ impl SamplingJob<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::anim::{Channel, Interpolation, JointTrack};
     use glam::Vec3;
 
     fn ramp() -> Clip {
         // x goes 0 → 10 over 10 s in 1 s keys: x(t) = t.
-        let times: Vec<f32> = (0..=10).map(|k| k as f32).collect();
-        let values = times.iter().map(|&t| Vec3::new(t, 0.0, 0.0)).collect();
-        Clip {
-            name: "ramp".into(),
-            duration: 10.0,
-            tracks: vec![JointTrack {
-                joint: 0,
-                translation: Some(Channel {
-                    interpolation: Interpolation::Linear,
-                    times,
-                    values,
-                }),
-                rotation: None,
-                scale: None,
-            }],
-        }
+        let keys = (0..=10).map(|k| (k as f32, Vec3::new(k as f32, 0.0, 0.0)));
+        Clip::linear_translation("ramp", 10.0, 0, keys)
     }
 
     #[test]

@@ -106,7 +106,6 @@ impl Ropes {
         }
         rig.validate_for(skeleton)?;
         for s in &rig.ropes {
-            s.validate()?;
             let missing = |n: &str| Error::MissingBone {
                 context: format!("rope '{}'", s.name),
                 name: n.to_string(),
@@ -137,16 +136,6 @@ impl Ropes {
                 .filter(|(_, c)| s.colliders.is_empty() || s.colliders.contains(&c.name))
                 .map(|(compiled, _)| compiled)
                 .collect();
-            if let Some(missing) = s
-                .colliders
-                .iter()
-                .find(|n| !rig.colliders.iter().any(|c| &c.name == *n))
-            {
-                return Err(Error::InvalidParameter(format!(
-                    "rope '{}' names collider '{missing}', which the rig does not define",
-                    s.name
-                )));
-            }
             let mut world = ParticleWorld::new(s.world.clone());
             let rest = crate::pose::Pose::rest(skeleton);
             let m = s.mass / bones.len() as f32;

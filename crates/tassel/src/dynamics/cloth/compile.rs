@@ -141,7 +141,7 @@ impl ClothRig {
             // Per-point parameters over the normalised chain position.
             for ch in &chains {
                 let n = ch.len();
-                for (k, _) in ch.clone().enumerate() {
+                for k in 0..n {
                     let x = if n > 1 {
                         k as f32 / (n - 1) as f32
                     } else {

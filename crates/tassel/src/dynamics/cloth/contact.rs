@@ -127,7 +127,7 @@ pub(crate) fn push_triangle(
     let gain = 3.0 / movable;
     for (v, f) in p.into_iter().zip(free) {
         if f {
-            *v += shift * gain.min(3.0);
+            *v += shift * gain;
         }
     }
 }
