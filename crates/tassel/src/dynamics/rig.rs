@@ -57,13 +57,16 @@ impl CompiledCollider {
             .collect()
     }
 
-    /// Where it is for the model pose `models`, seen from `frame` (identity: model
-    /// space; the character's transform: world space). Scale is ignored.
-    pub fn place(&self, models: &[Transform], frame: &Transform) -> PlacedCollider {
-        let bone = &models[self.bone];
-        let t = *frame
-            * Transform::from_translation_rotation(bone.translation, bone.rotation)
-            * self.offset;
+    /// Where it is for the model pose `models`: in model space without `frame`, in the
+    /// space `frame` maps model space to (the character's transform: world) with it.
+    /// Scale is ignored.
+    pub fn place(&self, models: &[Transform], frame: Option<&Transform>) -> PlacedCollider {
+        let b = &models[self.bone];
+        let bone = Transform::from_translation_rotation(b.translation, b.rotation);
+        let t = match frame {
+            Some(f) => *f * bone * self.offset,
+            None => bone * self.offset,
+        };
         PlacedCollider {
             shape: self.shape,
             transform: Transform::from_translation_rotation(t.translation, t.rotation),

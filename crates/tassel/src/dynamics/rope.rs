@@ -225,7 +225,7 @@ impl Ropes {
             }
             world.colliders.clear();
             for c in &rope.colliders {
-                world.colliders.push(c.place(models, &frame));
+                world.colliders.push(c.place(models, Some(&frame)));
             }
             if let Some(h) = s.ground {
                 world.add_ground(h);

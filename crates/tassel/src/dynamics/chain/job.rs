@@ -250,7 +250,7 @@ fn gather_targets(
         }
     }
     for (placed, c) in colliders.iter_mut().zip(&rig.colliders) {
-        *placed = c.place(models, &Transform::IDENTITY);
+        *placed = c.place(models, None);
     }
 }
 

@@ -196,7 +196,7 @@ fn gather(rig: &ClothRig, models: &[Transform], component: &Transform, state: &m
     }
     let frame = Transform::from_translation_rotation(component.translation, component.rotation);
     for (placed, c) in state.colliders.iter_mut().zip(&rig.colliders) {
-        *placed = c.place(models, &frame);
+        *placed = c.place(models, Some(&frame));
     }
 }
 
