@@ -5,8 +5,9 @@ use glam::{Quat, Vec3};
 use serde_json::json;
 use std::path::PathBuf;
 use tassel::dynamics::chain::TimeMode;
+use tassel::dynamics::vrm::{VrmMode, VrmOptions};
 use tassel::dynamics::RigSettings;
-use tassel::{builtin, CharacterSim, Pose, Skeleton, Transform};
+use tassel::{builtin, CharacterSim, Transform};
 
 #[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 enum Mode {
@@ -34,15 +35,18 @@ enum Axis {
 /// Options of `tassel simulate`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// The model (.glb, .gltf); omit with --builtin.
+    /// The model (.glb, .gltf, .vrm); omit with --builtin.
     model: Option<PathBuf>,
-    /// Rig file (TOML) with chains and colliders; with --builtin it replaces the built-in rig.
+    /// Rig file (TOML) with chains and colliders; with --builtin it replaces the built-in
+    /// rig; optional for a VRM (its spring bones run in any case).
     #[arg(long)]
     rig: Option<PathBuf>,
     /// Use the embedded character.
     #[arg(long)]
     builtin: bool,
-    /// Time mode for every chain (default: what the rig says).
+    /// spec: VRM springs by the specification (default for VRM); fixed: VRM springs and
+    /// chains at a fixed rate; classic: chains frame by frame (VRM springs spec).
+    /// Default for a rig: what the rig says.
     #[arg(long, value_enum)]
     mode: Option<Mode>,
     /// Number of frames.
@@ -91,6 +95,17 @@ fn read_rig(path: &PathBuf) -> Result<RigSettings, String> {
     RigSettings::from_toml_str(&text).map_err(|e| format!("{}: {e}", path.display()))
 }
 
+/// What a listed joint's tail is.
+#[derive(Clone, Copy)]
+enum Tail {
+    /// A joint of the skeleton.
+    Joint(usize),
+    /// A point in the joint's own space (a VRM virtual tail).
+    Local(glam::Vec3),
+    /// A virtual chain point (model space, from the chain state).
+    ChainPoint(usize),
+}
+
 pub fn run(a: Args) -> Result<(), String> {
     if !(a.dt.is_finite() && a.dt > 0.0 && a.dt <= 1.0) {
         return Err(format!(
@@ -106,106 +121,128 @@ pub fn run(a: Args) -> Result<(), String> {
             return Err(format!("{name} {v} is not a finite number"));
         }
     }
-    let (skeleton, mut rig, joint_to_node): (Skeleton, RigSettings, Vec<usize>) =
-        match (&a.model, a.builtin) {
-            (Some(_), true) => return Err("give either MODEL or --builtin, not both".into()),
-            (None, false) => return Err("give a MODEL file or --builtin".into()),
-            (None, true) => {
-                let c = builtin::character();
-                let rig = match &a.rig {
-                    Some(p) => read_rig(p)?,
-                    None => c.rig,
-                };
-                let n = c.skeleton.len();
-                (c.skeleton, rig, (0..n).collect())
-            }
-            (Some(path), false) => {
-                let model = tassel_gltf::load(path).map_err(|e| e.to_string())?;
-                let rig = match &a.rig {
-                    Some(p) => read_rig(p)?,
-                    None => {
-                        return Err(format!(
-                            "{}: give --rig RIG.toml (VRM spring bones are not supported yet)",
-                            path.display()
-                        ))
-                    }
-                };
-                (model.skeleton, rig, model.joint_to_node)
-            }
-        };
-    let mode_name = match a.mode {
-        Some(Mode::Spec) => return Err("--mode spec is the VRM spring-bone mode, which is not supported yet; use fixed or classic".into()),
-        Some(Mode::Fixed) => "fixed",
-        Some(Mode::Classic) => "classic",
+    let (skeleton, mut rig, joint_to_node, vrm) = match (&a.model, a.builtin) {
+        (Some(_), true) => return Err("give either MODEL or --builtin, not both".into()),
+        (None, false) => return Err("give a MODEL file or --builtin".into()),
+        (None, true) => {
+            let c = builtin::character();
+            let rig = match &a.rig {
+                Some(p) => read_rig(p)?,
+                None => c.rig,
+            };
+            let n = c.skeleton.len();
+            (c.skeleton, rig, (0..n).collect::<Vec<_>>(), None)
+        }
+        (Some(path), false) => {
+            let model = tassel_gltf::load(path).map_err(|e| e.to_string())?;
+            let vrm = model.vrm.map(|v| v.springs);
+            let rig = match &a.rig {
+                Some(p) => read_rig(p)?,
+                None if vrm.is_some() => RigSettings::default(),
+                None => {
+                    return Err(format!(
+                        "{}: the file has no VRM spring bones; give --rig RIG.toml",
+                        path.display()
+                    ))
+                }
+            };
+            (model.skeleton, rig, model.joint_to_node, vrm)
+        }
+    };
+    let vrm = vrm.unwrap_or_default();
+    let has_vrm = !vrm.is_empty();
+    let mode = match a.mode {
+        Some(m) => m,
+        None if has_vrm => Mode::Spec,
         None => match rig.chains.first().map(|c| c.mode) {
-            Some(TimeMode::Classic) => "classic",
-            _ => "fixed",
+            Some(TimeMode::Classic) => Mode::Classic,
+            _ => Mode::Fixed,
         },
     };
-    if let Some(m) = a.mode {
+    let mode_name = match mode {
+        Mode::Spec => "spec",
+        Mode::Fixed => "fixed",
+        Mode::Classic => "classic",
+    };
+    if mode == Mode::Spec && !has_vrm {
+        return Err(
+            "--mode spec is the VRM spring-bone mode and this model has no VRM springs; use fixed or classic"
+                .into(),
+        );
+    }
+    // spec: VRM springs by the specification, chains keep the rig's mode; fixed: both
+    // fixed; classic: chains classic, VRM springs spec (the frame-rate-dependent pair).
+    if a.mode.is_some() && mode != Mode::Spec {
         for c in &mut rig.chains {
-            c.mode = if m == Mode::Classic {
+            c.mode = if mode == Mode::Classic {
                 TimeMode::Classic
             } else {
                 TimeMode::Fixed
             };
         }
     }
-    let mut sim = CharacterSim::new(skeleton.clone(), &rig).map_err(|e| e.to_string())?;
-    let joints: Vec<(usize, usize, usize)> = sim.chains().rotating_joints().collect();
+    let options = VrmOptions {
+        mode: if mode == Mode::Fixed {
+            VrmMode::Fixed
+        } else {
+            VrmMode::Spec
+        },
+        ..VrmOptions::default()
+    };
+    let mut sim =
+        CharacterSim::with_vrm(skeleton.clone(), &rig, &vrm, options).map_err(|e| e.to_string())?;
+    let mut joints: Vec<(usize, Tail)> = sim
+        .vrm()
+        .links
+        .iter()
+        .map(|l| {
+            (
+                l.joint,
+                match l.tail_joint {
+                    Some(t) => Tail::Joint(t),
+                    None => Tail::Local(l.tail_local),
+                },
+            )
+        })
+        .collect();
+    joints.extend(sim.chains().rotating_joints().map(|(j, _, tail)| {
+        (
+            j,
+            match sim.chains().point(tail).joint {
+                Some(tj) => Tail::Joint(tj),
+                None => Tail::ChainPoint(tail),
+            },
+        )
+    }));
     let rest = skeleton.rest().to_vec();
-    let world = |pose: &Pose, sim: &CharacterSim, comp: &Transform| {
-        let mut pos = Vec::new();
-        let mut tails = Vec::new();
-        let mut quats = Vec::new();
-        for &(j, _, tail) in &joints {
-            pos.push(comp.transform_point(pose.models[j].translation).to_array());
-            let tail_pos = match sim.chains().point(tail).joint {
-                Some(tj) => pose.models[tj].translation,
-                None => sim.state().output_positions()[tail],
+    let world = |sim: &CharacterSim, comp: &Transform| {
+        let models = &sim.pose().models;
+        let mut pos = Vec::with_capacity(joints.len());
+        let mut tails = Vec::with_capacity(joints.len());
+        let mut quats = Vec::with_capacity(joints.len());
+        for &(j, tail) in &joints {
+            let w = *comp * models[j];
+            pos.push(w.translation.to_array());
+            let tail_pos = match tail {
+                Tail::Joint(t) => comp.transform_point(models[t].translation),
+                Tail::Local(p) => w.transform_point(p),
+                Tail::ChainPoint(p) => comp.transform_point(sim.state().output_positions()[p]),
             };
-            tails.push(comp.transform_point(tail_pos).to_array());
-            quats.push(
-                (comp.rotation * pose.models[j].rotation)
-                    .normalize()
-                    .to_array(),
-            );
+            tails.push(tail_pos.to_array());
+            quats.push(w.rotation.normalize().to_array());
         }
         (pos, tails, quats)
     };
-    let rest_pose = Pose::rest(&skeleton);
-    let initial_tails: Vec<[f32; 3]> = joints
-        .iter()
-        .map(|&(_, _, tail)| match sim.chains().point(tail).joint {
-            Some(tj) => rest_pose.models[tj].translation.to_array(),
-            None => Vec3::ZERO.to_array(),
-        })
-        .collect();
-    // Settle the state at rest before frame 1 (a zero-length frame).
+    // The rest state before frame 1: a zero-length frame initialises every solver there.
     sim.frame(&rest, Transform::IDENTITY, 0.0)
         .map_err(|e| e.to_string())?;
-    let (initial_pos, virtual_tails, _) = world(&rest_pose, &sim, &Transform::IDENTITY);
-    let initial_tails: Vec<[f32; 3]> = initial_tails
-        .iter()
-        .zip(&virtual_tails)
-        .zip(&joints)
-        .map(|((r, v), &(_, _, tail))| {
-            if sim.chains().point(tail).joint.is_some() {
-                *r
-            } else {
-                *v
-            }
-        })
-        .collect();
+    let (initial_pos, initial_tails, _) = world(&sim, &Transform::IDENTITY);
     let mut samples = Vec::with_capacity(a.frames);
     for f in 1..=a.frames {
         let t = f as f32 * a.dt;
         let comp = root_motion(&a, t);
-        let pose = sim
-            .frame(&rest, comp, a.dt)
-            .map_err(|e| e.to_string())?
-            .clone();
-        let (pos, tails, quats) = world(&pose, &sim, &comp);
+        sim.frame(&rest, comp, a.dt).map_err(|e| e.to_string())?;
+        let (pos, tails, quats) = world(&sim, &comp);
         samples.push(json!({
             "frame": f, "t": t, "root_pos": comp.translation.to_array(),
             "world_pos": pos, "tail_world_pos": tails, "world_quat": quats,
@@ -213,11 +250,11 @@ pub fn run(a: Args) -> Result<(), String> {
     }
     let joint_list: Vec<_> = joints
         .iter()
-        .map(|&(j, _, tail)| {
+        .map(|&(j, tail)| {
             json!({
                 "node": joint_to_node[j],
                 "name": skeleton.name(j),
-                "tail_node": sim.chains().point(tail).joint.map(|tj| joint_to_node[tj]),
+                "tail_node": match tail { Tail::Joint(t) => Some(joint_to_node[t]), _ => None },
             })
         })
         .collect();

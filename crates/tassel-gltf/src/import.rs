@@ -33,6 +33,8 @@ pub struct Model {
     pub clips: Vec<Clip>,
     /// Things the loader accepted but a user should know.
     pub warnings: Vec<String>,
+    /// The file's VRM spring bones (`VRMC_springBone` 1.0 or VRM 0.x), if any.
+    pub vrm: Option<crate::VrmInfo>,
     /// The parsed JSON and resolved buffers, for export.
     pub source: crate::ExportSource,
 }
@@ -52,7 +54,9 @@ pub fn load_slice(bytes: &[u8], base_dir: Option<&Path>, name: &str) -> Result<M
         path: name.to_string(),
         message,
     };
-    let gltf = gltf::Gltf::from_slice(bytes).map_err(|e| invalid(e.to_string()))?;
+    let gltf =
+        gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| invalid(e.to_string()))?;
+    validate(&gltf).map_err(invalid)?;
     let doc = &gltf.document;
     let mut buffers: Vec<Vec<u8>> = Vec::new();
     for b in doc.buffers() {
@@ -258,6 +262,13 @@ pub fn load_slice(bytes: &[u8], base_dir: Option<&Path>, name: &str) -> Result<M
     let json: serde_json::Value =
         serde_json::to_value(doc.as_json()).map_err(|e| invalid(e.to_string()))?;
     let json = raw_json(bytes).unwrap_or(json);
+    let vrm = crate::vrm::read_spring_bones(&json, &node_to_joint, &mut warnings)
+        .map_err(|m| invalid(format!("spring bones: {m}")))?;
+    if let Some(v) = &vrm {
+        v.springs
+            .validate_for(&skeleton)
+            .map_err(|e| invalid(format!("spring bones: {e}")))?;
+    }
     Ok(Model {
         skeleton,
         node_to_joint,
@@ -265,12 +276,49 @@ pub fn load_slice(bytes: &[u8], base_dir: Option<&Path>, name: &str) -> Result<M
         skins,
         clips,
         warnings,
+        vrm,
         source: crate::ExportSource {
             json,
             buffers,
             base_dir: base_dir.map(Path::to_path_buf),
         },
     })
+}
+
+/// Extensions a file may require that Tassel reads itself (the gltf crate does not know
+/// them): the VRM family.
+fn handled_here(ext: &str) -> bool {
+    ext.starts_with("VRMC_") || ext == "VRM"
+}
+
+/// The gltf crate's validation, except that required VRM extensions are accepted.
+fn validate(gltf: &gltf::Gltf) -> Result<(), String> {
+    use gltf::json::validation::{Error as V, Validate};
+    let root = gltf.document.as_json();
+    let mut errors = Vec::new();
+    root.validate(root, gltf::json::Path::new, &mut |path, error| {
+        errors.push((path(), error))
+    });
+    errors.retain(|(path, error)| {
+        let required = root.extensions_required.iter().enumerate().any(|(i, ext)| {
+            handled_here(ext)
+                && path
+                    .as_str()
+                    .starts_with(&format!("extensionsRequired[{i}]"))
+        });
+        !(required && *error == V::Unsupported)
+    });
+    match errors.first() {
+        None => Ok(()),
+        Some(_) => Err(format!(
+            "invalid glTF: {}",
+            errors
+                .iter()
+                .map(|(p, e)| format!("{}: {e:?}", p.as_str()))
+                .collect::<Vec<_>>()
+                .join("; ")
+        )),
+    }
 }
 
 /// The document's JSON exactly as written (keeps extensions the typed model drops).

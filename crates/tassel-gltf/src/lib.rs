@@ -1,14 +1,17 @@
 //! glTF 2.0 import and export for Tassel.
 //!
 //! - [`load`] / [`load_slice`]: nodes (every node becomes a joint), skins with their
-//!   inverse bind matrices, the rest pose and animation clips.
+//!   inverse bind matrices, the rest pose and animation clips, and VRM spring bones
+//!   (`VRMC_springBone` 1.0 with extended colliders, VRM 0.x `secondaryAnimation`).
 //! - [`export_glb`]: a GLB with the skeleton (and, when there was an input file, its
 //!   meshes, skins, materials and textures) plus baked animations, one key per frame.
 
 mod error;
 mod export;
 mod import;
+mod vrm;
 
 pub use error::GltfError;
 pub use export::{export_glb, BakedClip, BakedTrack, BoneMesh, ExportSource};
 pub use import::{load, load_slice, Model, SkinInfo};
+pub use vrm::{read_spring_bones, VrmInfo, VrmVersion, VRM0_TAIL_LENGTH};

@@ -4,6 +4,7 @@ use crate::dynamics::chain::{ChainJob, ChainRig, ChainState};
 use crate::dynamics::cloth::{ClothJob, ClothRig, ClothState};
 use crate::dynamics::rope::Ropes;
 use crate::dynamics::spring::{SpringJob, SpringRig, SpringState};
+use crate::dynamics::vrm::{VrmJob, VrmOptions, VrmRig, VrmSpringBones, VrmState};
 use crate::dynamics::RigSettings;
 use crate::error::{Error, Result};
 use crate::math::Transform;
@@ -30,6 +31,8 @@ pub struct CharacterSim {
     cloths: ClothRig,
     cloth_state: ClothState,
     ropes: Ropes,
+    vrm: VrmRig,
+    vrm_state: VrmState,
     pose: Pose,
     animated_models: Vec<Transform>,
 }
@@ -37,6 +40,25 @@ pub struct CharacterSim {
 impl CharacterSim {
     /// Compiles `rig` for `skeleton`.
     pub fn new(skeleton: Skeleton, rig: &RigSettings) -> Result<Self> {
+        Self::with_vrm(
+            skeleton,
+            rig,
+            &VrmSpringBones::default(),
+            VrmOptions::default(),
+        )
+    }
+
+    /// Compiles `rig` and a model's VRM spring bones for `skeleton`. The VRM springs run
+    /// first (on the animated pose), then chains, springs, cloths and ropes; a bone may
+    /// belong to one solver only.
+    pub fn with_vrm(
+        skeleton: Skeleton,
+        rig: &RigSettings,
+        vrm: &VrmSpringBones,
+        options: VrmOptions,
+    ) -> Result<Self> {
+        let vrm = VrmRig::new(&skeleton, vrm, options)?;
+        let vrm_state = VrmState::new(&vrm);
         let chains = ChainRig::new(&skeleton, rig)?;
         let state = ChainState::new(&chains);
         let springs = SpringRig::new(&skeleton, &rig.springs)?;
@@ -71,6 +93,33 @@ impl CharacterSim {
                 )));
             }
         }
+        for j in vrm.simulated_joints() {
+            let other = if (0..chains.point_count()).any(|p| {
+                let info = chains.point(p);
+                info.joint == Some(j) && info.parent.is_some()
+            }) || chains.rotating_joints().any(|(rj, _, _)| rj == j)
+            {
+                Some("chain")
+            } else if rig
+                .springs
+                .iter()
+                .any(|s| skeleton.find(&s.bone) == Some(j))
+            {
+                Some("spring")
+            } else if cloth_joints.contains(&j) {
+                Some("cloth")
+            } else if ropes.simulated_joints().any(|r| r == j) {
+                Some("rope")
+            } else {
+                None
+            };
+            if let Some(other) = other {
+                return Err(Error::InvalidParameter(format!(
+                    "bone '{}' is simulated by a VRM spring and by a {other} of the rig file",
+                    skeleton.name(j)
+                )));
+            }
+        }
         let pose = Pose::rest(&skeleton);
         let animated_models = pose.models.clone();
         Ok(Self {
@@ -82,6 +131,8 @@ impl CharacterSim {
             cloths,
             cloth_state,
             ropes,
+            vrm,
+            vrm_state,
             pose,
             animated_models,
         })
@@ -111,6 +162,18 @@ impl CharacterSim {
         }
         .run()?;
         self.animated_models.copy_from_slice(&self.pose.models);
+        if !self.vrm.is_empty() {
+            VrmJob {
+                skeleton: &self.skeleton,
+                rig: &self.vrm,
+                state: &mut self.vrm_state,
+                component,
+                dt,
+                locals: &mut self.pose.locals,
+                models: &mut self.pose.models,
+            }
+            .run()?;
+        }
         ChainJob {
             skeleton: &self.skeleton,
             rig: &self.rig,
@@ -195,6 +258,16 @@ impl CharacterSim {
         &self.ropes
     }
 
+    /// The compiled VRM spring bones.
+    pub fn vrm(&self) -> &VrmRig {
+        &self.vrm
+    }
+
+    /// The VRM spring-bone state.
+    pub fn vrm_state(&self) -> &VrmState {
+        &self.vrm_state
+    }
+
     /// The last output pose.
     pub fn pose(&self) -> &Pose {
         &self.pose
@@ -211,5 +284,6 @@ impl CharacterSim {
         self.spring_state.reset();
         self.cloth_state.reset();
         self.ropes.reset();
+        self.vrm_state.reset();
     }
 }

@@ -1,7 +1,7 @@
 //! Secondary motion solvers: `chain`, the KawaiiPhysics-style bone chain (seed 000);
 //! `spring`, Unreal's spring controller (seed 002); `cloth`, SPCRJointDynamics' bone cloth
-//! (seed 004); `particles`, a general Verlet particle-constraint world (seed 001), and
-//! `rope`, bone chains driven by it.
+//! (seed 004); `particles`, a general Verlet particle-constraint world (seed 001);
+//! `rope`, bone chains driven by it; and `vrm`, VRM spring bones by the VRM specification.
 
 pub mod chain;
 pub mod cloth;
@@ -10,6 +10,7 @@ pub mod particles;
 mod rig;
 pub mod rope;
 pub mod spring;
+pub mod vrm;
 
 pub use curve::Curve;
 pub(crate) use rig::CompiledCollider;

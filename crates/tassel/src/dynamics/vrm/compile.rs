@@ -1,0 +1,131 @@
+//! Compiling VRM spring bones for a skeleton: one link per simulated joint, in the order
+//! the update must visit them (ancestors first), with the rest data the spec's
+//! initialisation records.
+
+use super::settings::{VrmOptions, VrmShape, VrmSpringBones, VrmTail};
+use crate::error::Result;
+use crate::math::{normalize_or, Transform};
+use crate::pose::Pose;
+use crate::skeleton::Skeleton;
+use glam::Vec3;
+use std::ops::Range;
+
+/// One simulated joint, compiled.
+#[derive(Debug, Clone, PartialEq)]
+pub struct VrmLink {
+    /// The joint that turns.
+    pub joint: usize,
+    /// Its parent joint (`None` at a skeleton root: the character transform is the parent).
+    pub parent: Option<usize>,
+    /// The tail joint, when the tail is a joint.
+    pub tail_joint: Option<usize>,
+    /// The tail in the joint's rest local space.
+    pub tail_local: Vec3,
+    /// `tail_local` normalised: the spec's `boneAxis`.
+    pub bone_axis: Vec3,
+    /// The joint's rest local transform (`initialLocalMatrix`, `initialLocalRotation`).
+    pub rest_local: Transform,
+    /// Index of the spring in the settings.
+    pub spring: usize,
+    /// Tail sphere radius, metres.
+    pub hit_radius: f32,
+    /// Stiffness, 1/s.
+    pub stiffness: f32,
+    /// Gravity direction × power, world, m/s.
+    pub gravity: Vec3,
+    /// Drag, 0..=1.
+    pub drag_force: f32,
+    /// Centre joint of the spring.
+    pub center: Option<usize>,
+    /// Range in [`VrmRig::link_colliders`].
+    pub colliders: Range<usize>,
+}
+
+/// VRM spring bones compiled for one skeleton. Shareable between characters.
+#[derive(Debug, Clone, PartialEq)]
+pub struct VrmRig {
+    /// Links in processing order (ascending joint index: every ancestor before its
+    /// descendants).
+    pub links: Vec<VrmLink>,
+    /// Collider shapes and their joints.
+    pub colliders: Vec<(usize, VrmShape)>,
+    /// Collider indices of each link (deduplicated, in group order).
+    pub link_colliders: Vec<usize>,
+    /// Solver options.
+    pub options: VrmOptions,
+    joint_count: usize,
+}
+
+impl VrmRig {
+    /// Validates `bones` for `skeleton` and compiles them.
+    pub fn new(skeleton: &Skeleton, bones: &VrmSpringBones, options: VrmOptions) -> Result<Self> {
+        bones.validate_for(skeleton)?;
+        options.validate()?;
+        let rest = Pose::rest(skeleton);
+        let mut links = Vec::new();
+        let mut link_colliders = Vec::new();
+        for (si, s) in bones.springs.iter().enumerate() {
+            let mut cols: Vec<usize> = Vec::new();
+            for &g in &s.collider_groups {
+                for &c in &bones.collider_groups[g].colliders {
+                    if !cols.contains(&c) {
+                        cols.push(c);
+                    }
+                }
+            }
+            for j in &s.joints {
+                let (tail_joint, tail_local) = match j.tail {
+                    VrmTail::Joint(t) => (
+                        Some(t),
+                        rest.models[t]
+                            .relative_to(&rest.models[j.joint])
+                            .translation,
+                    ),
+                    VrmTail::Local(p) => (None, p),
+                };
+                let start = link_colliders.len();
+                link_colliders.extend_from_slice(&cols);
+                links.push(VrmLink {
+                    joint: j.joint,
+                    parent: skeleton.parent(j.joint),
+                    tail_joint,
+                    tail_local,
+                    bone_axis: normalize_or(tail_local, Vec3::Y),
+                    rest_local: skeleton.rest()[j.joint],
+                    spring: si,
+                    hit_radius: j.hit_radius,
+                    stiffness: j.stiffness,
+                    gravity: j.gravity_dir * j.gravity_power,
+                    drag_force: j.drag_force,
+                    center: s.center,
+                    colliders: start..link_colliders.len(),
+                });
+            }
+        }
+        // Ancestors first: the skeleton is depth-first, so a stable sort by joint index
+        // puts every joint after all of its ancestors (within and across springs).
+        links.sort_by_key(|l| l.joint);
+        Ok(Self {
+            links,
+            colliders: bones.colliders.iter().map(|c| (c.joint, c.shape)).collect(),
+            link_colliders,
+            options,
+            joint_count: skeleton.len(),
+        })
+    }
+
+    /// Number of skeleton joints the rig was compiled for.
+    pub fn joint_count(&self) -> usize {
+        self.joint_count
+    }
+
+    /// True when nothing is simulated.
+    pub fn is_empty(&self) -> bool {
+        self.links.is_empty()
+    }
+
+    /// The simulated joints in processing order.
+    pub fn simulated_joints(&self) -> impl Iterator<Item = usize> + '_ {
+        self.links.iter().map(|l| l.joint)
+    }
+}

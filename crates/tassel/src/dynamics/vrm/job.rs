@@ -1,0 +1,404 @@
+//! Per-character spring-bone state and the frame job: the specification's update, run once
+//! per frame (`spec`) or at a fixed rate with interpolation (`fixed`).
+
+use super::collide::PlacedVrmCollider;
+use super::compile::VrmRig;
+use super::settings::VrmMode;
+use crate::error::{Error, Result};
+use crate::math::{normalize_or, rotation_arc, slerp_shortest, Transform};
+use crate::pose::LocalToModelJob;
+use crate::skeleton::Skeleton;
+use glam::{Quat, Vec3};
+
+/// The small per-character state of a [`VrmRig`]: each link's tail now and one step ago
+/// (in world space, or in its spring's centre space) and its last two rotations.
+#[derive(Debug, Clone)]
+pub struct VrmState {
+    current_tail: Vec<Vec3>,
+    prev_tail: Vec<Vec3>,
+    length: Vec<f32>,
+    rotation: Vec<Quat>,
+    rotation_before: Vec<Quat>,
+    placed: Vec<PlacedVrmCollider>,
+    // Fixed mode: last frame's animated input and the scratch pose of a step.
+    prev_locals: Vec<Transform>,
+    step_locals: Vec<Transform>,
+    step_models: Vec<Transform>,
+    prev_component: Transform,
+    accumulator: f32,
+    needs_reset: bool,
+    resets: u64,
+}
+
+impl VrmState {
+    /// Fresh state for `rig`; the first frame initialises it from the pose it is given.
+    pub fn new(rig: &VrmRig) -> Self {
+        let l = rig.links.len();
+        let n = rig.joint_count();
+        let none = PlacedVrmCollider::Plane {
+            point: Vec3::ZERO,
+            normal: Vec3::Y,
+        };
+        Self {
+            current_tail: vec![Vec3::ZERO; l],
+            prev_tail: vec![Vec3::ZERO; l],
+            length: vec![0.0; l],
+            rotation: vec![Quat::IDENTITY; l],
+            rotation_before: vec![Quat::IDENTITY; l],
+            placed: vec![none; rig.colliders.len()],
+            prev_locals: vec![Transform::IDENTITY; n],
+            step_locals: vec![Transform::IDENTITY; n],
+            step_models: vec![Transform::IDENTITY; n],
+            prev_component: Transform::IDENTITY,
+            accumulator: 0.0,
+            needs_reset: true,
+            resets: 0,
+        }
+    }
+
+    /// Makes the next frame start again from its pose (the spec's `reset`).
+    pub fn reset(&mut self) {
+        self.needs_reset = true;
+    }
+
+    /// The character was moved on purpose: start again instead of whipping.
+    pub fn teleport(&mut self) {
+        self.reset();
+    }
+
+    /// Each link's current tail in world space, given the character transform and the
+    /// model pose the tails were last computed with.
+    pub fn tails_world(
+        &self,
+        rig: &VrmRig,
+        component: &Transform,
+        models: &[Transform],
+    ) -> Vec<Vec3> {
+        rig.links
+            .iter()
+            .zip(&self.current_tail)
+            .map(|(l, &t)| match l.center {
+                Some(c) => (*component * models[c]).transform_point(t),
+                None => t,
+            })
+            .collect()
+    }
+
+    /// Bone lengths (joint to tail, world metres) recorded at the last reset.
+    pub fn lengths(&self) -> &[f32] {
+        &self.length
+    }
+
+    /// Colliders as placed for the last step, world space, in the rig's collider order.
+    pub fn placed_colliders(&self) -> &[PlacedVrmCollider] {
+        &self.placed
+    }
+
+    /// How many resets (first frame, teleports, non-finite recoveries) happened so far.
+    pub fn reset_count(&self) -> u64 {
+        self.resets
+    }
+}
+
+/// One frame of a character's VRM spring bones.
+///
+/// Reads the animated pose (`locals` and the `models` computed from them, model space)
+/// and the character's world transform; writes the simulated joints' local rotations and
+/// recomputes `models`.
+#[derive(Debug)]
+pub struct VrmJob<'a> {
+    /// The skeleton the rig was compiled for.
+    pub skeleton: &'a Skeleton,
+    /// The compiled springs.
+    pub rig: &'a VrmRig,
+    /// The character's state.
+    pub state: &'a mut VrmState,
+    /// The character's world transform this frame.
+    pub component: Transform,
+    /// Frame time, seconds (finite, ≥ 0).
+    pub dt: f32,
+    /// In: animated local transforms. Out: with simulated rotations.
+    pub locals: &'a mut [Transform],
+    /// In: animated model transforms. Out: recomputed from the new locals.
+    pub models: &'a mut [Transform],
+}
+
+impl VrmJob<'_> {
+    /// Checks sizes and that the inputs are finite.
+    pub fn validate(&self) -> Result<()> {
+        let n = self.skeleton.len();
+        for (what, got) in [
+            ("VRM rig joints", self.rig.joint_count()),
+            ("locals", self.locals.len()),
+            ("models", self.models.len()),
+        ] {
+            if got != n {
+                return Err(Error::LengthMismatch {
+                    what,
+                    expected: n,
+                    got,
+                });
+            }
+        }
+        if !(self.dt.is_finite() && self.dt >= 0.0) {
+            return Err(Error::InvalidTimeStep(self.dt));
+        }
+        if !self.component.is_finite() {
+            return Err(Error::NonFinite("character transform".into()));
+        }
+        if let Some(i) = self.locals.iter().position(|m| !m.is_finite()) {
+            return Err(Error::NonFinite(format!(
+                "animated pose of joint '{}'",
+                self.skeleton.name(i)
+            )));
+        }
+        Ok(())
+    }
+
+    /// Validates, then runs the frame. Never allocates.
+    pub fn run(self) -> Result<()> {
+        self.validate()?;
+        let VrmJob {
+            skeleton,
+            rig,
+            state,
+            component,
+            dt,
+            locals,
+            models,
+        } = self;
+        if rig.links.is_empty() {
+            return Ok(());
+        }
+        let opts = &rig.options;
+        if !state.needs_reset && opts.teleport_distance > 0.0 {
+            let moved = (component.translation - state.prev_component.translation).length();
+            if moved > opts.teleport_distance {
+                state.needs_reset = true;
+            }
+        }
+        if state.needs_reset {
+            reset(skeleton, rig, state, &component, locals, models);
+        } else {
+            match opts.mode {
+                VrmMode::Spec => {
+                    if dt > 0.0 {
+                        place_colliders(rig, state, &component, models);
+                        update(skeleton, rig, state, &component, dt, locals, models);
+                    }
+                    state.rotation_before.copy_from_slice(&state.rotation);
+                }
+                VrmMode::Fixed => run_fixed(skeleton, rig, state, &component, dt, locals),
+            }
+        }
+        // Guard: never let a non-finite value out; start again from the pose instead.
+        if state.current_tail.iter().any(|t| !t.is_finite())
+            || state.rotation.iter().any(|q| !q.is_finite())
+        {
+            reset(skeleton, rig, state, &component, locals, models);
+        }
+        state.prev_locals.copy_from_slice(locals);
+        state.prev_component = component;
+        // Output: the last rotations (fixed mode: between the last two steps).
+        let w = match opts.mode {
+            VrmMode::Spec => 1.0,
+            VrmMode::Fixed => (state.accumulator * opts.step_rate).clamp(0.0, 1.0),
+        };
+        for (i, l) in rig.links.iter().enumerate() {
+            locals[l.joint].rotation = if w >= 1.0 {
+                state.rotation[i]
+            } else {
+                slerp_shortest(state.rotation_before[i], state.rotation[i], w)
+            };
+        }
+        LocalToModelJob {
+            skeleton,
+            root: Transform::IDENTITY,
+            locals,
+            models,
+        }
+        .run()
+    }
+}
+
+/// The spec's initialisation from the given pose: joints at their rest rotation, tails
+/// where the rest rotation puts them, no velocity.
+fn reset(
+    sk: &Skeleton,
+    rig: &VrmRig,
+    state: &mut VrmState,
+    component: &Transform,
+    locals: &mut [Transform],
+    models: &mut [Transform],
+) {
+    for l in &rig.links {
+        locals[l.joint].rotation = l.rest_local.rotation;
+    }
+    local_to_model(sk, locals, models, 0);
+    for (i, l) in rig.links.iter().enumerate() {
+        let world = *component * models[l.joint];
+        let tail = world.transform_point(l.tail_local);
+        state.length[i] = (tail - world.translation).length();
+        let stored = match l.center {
+            Some(c) => (*component * models[c]).inverse_transform_point(tail),
+            None => tail,
+        };
+        state.current_tail[i] = stored;
+        state.prev_tail[i] = stored;
+        state.rotation[i] = l.rest_local.rotation;
+        state.rotation_before[i] = l.rest_local.rotation;
+    }
+    state.accumulator = 0.0;
+    state.needs_reset = false;
+    state.resets += 1;
+}
+
+fn local_to_model(sk: &Skeleton, locals: &[Transform], models: &mut [Transform], from: usize) {
+    for k in from..sk.len() {
+        models[k] = match sk.parent(k) {
+            Some(p) => models[p] * locals[k],
+            None => locals[k],
+        };
+    }
+}
+
+fn place_colliders(
+    rig: &VrmRig,
+    state: &mut VrmState,
+    component: &Transform,
+    models: &[Transform],
+) {
+    for (placed, (joint, shape)) in state.placed.iter_mut().zip(&rig.colliders) {
+        *placed = PlacedVrmCollider::place(shape, &(*component * models[*joint]));
+    }
+}
+
+/// One update of every link with time step `dt` (the specification's procedure):
+/// `models` must be the model pose of `locals`; both are updated as rotations are written.
+fn update(
+    sk: &Skeleton,
+    rig: &VrmRig,
+    state: &mut VrmState,
+    component: &Transform,
+    dt: f32,
+    locals: &mut [Transform],
+    models: &mut [Transform],
+) {
+    // Model transforms at or above this index are stale (a rotation above them changed).
+    let mut stale_from = sk.len();
+    for (i, l) in rig.links.iter().enumerate() {
+        if stale_from <= l.joint {
+            refresh(sk, locals, models, stale_from, l.joint);
+        }
+        let parent_world = match l.parent {
+            Some(p) => *component * models[p],
+            None => *component,
+        };
+        let position = (*component * models[l.joint]).translation;
+        let center = l.center.map(|c| *component * models[c]);
+        let to_world = |t: Vec3| center.map_or(t, |c| c.transform_point(t));
+        let current = to_world(state.current_tail[i]);
+        let prev = to_world(state.prev_tail[i]);
+
+        // Verlet: inertia, stiffness toward the rest direction under the current parent,
+        // gravity; then back to the bone length.
+        let rest_dir = parent_world.rotation * (l.rest_local.rotation * l.bone_axis);
+        let inertia = (current - prev) * (1.0 - l.drag_force);
+        let stiffness = rest_dir * (l.stiffness * dt);
+        let external = l.gravity * dt;
+        let length = state.length[i];
+        let onto_sphere = |t: Vec3| position + normalize_or(t - position, rest_dir) * length;
+        let mut next = onto_sphere(current + inertia + stiffness + external);
+
+        for &c in &rig.link_colliders[l.colliders.clone()] {
+            let (dir, dist) = state.placed[c].collision(next, l.hit_radius);
+            if dist < 0.0 {
+                next = onto_sphere(next - dir * dist);
+            }
+        }
+
+        let to_stored = |t: Vec3| center.map_or(t, |c| c.inverse_transform_point(t));
+        state.prev_tail[i] = state.current_tail[i];
+        state.current_tail[i] = to_stored(next);
+
+        // Rotation: the rest local rotation turned from the bone axis to the tail, seen
+        // from the joint's rest frame under its current parent.
+        let rest_world = parent_world * l.rest_local;
+        let to = normalize_or(rest_world.inverse_transform_point(next), l.bone_axis);
+        let rotation = (l.rest_local.rotation * rotation_arc(l.bone_axis, to)).normalize();
+        state.rotation[i] = rotation;
+        locals[l.joint].rotation = rotation;
+        models[l.joint] = match l.parent {
+            Some(p) => models[p] * locals[l.joint],
+            None => locals[l.joint],
+        };
+        stale_from = l.joint + 1;
+    }
+    if stale_from < sk.len() {
+        refresh(sk, locals, models, stale_from, sk.len() - 1);
+    }
+}
+
+fn refresh(sk: &Skeleton, locals: &[Transform], models: &mut [Transform], from: usize, to: usize) {
+    for k in from..=to {
+        models[k] = match sk.parent(k) {
+            Some(p) => models[p] * locals[k],
+            None => locals[k],
+        };
+    }
+}
+
+/// Fixed mode: whole steps of `1/step_rate` up to now, each with the animated pose and the
+/// character transform interpolated to its time; remembers the last two step rotations.
+fn run_fixed(
+    sk: &Skeleton,
+    rig: &VrmRig,
+    state: &mut VrmState,
+    component: &Transform,
+    dt: f32,
+    locals: &[Transform],
+) {
+    let opts = &rig.options;
+    let h = 1.0 / opts.step_rate;
+    let acc_old = state.accumulator;
+    let mut total = acc_old + dt;
+    let mut steps = (total / h + 1e-4).floor() as u32;
+    if steps > opts.max_steps_per_frame {
+        // A hitch: drop the time we cannot afford, keep the most recent steps.
+        total -= (steps - opts.max_steps_per_frame) as f32 * h;
+        steps = opts.max_steps_per_frame;
+    }
+    let skipped = acc_old + dt - total;
+    for k in 1..=steps {
+        // Where this step ends between last frame (0) and this frame (1).
+        let end = k as f32 * h - acc_old + skipped;
+        let w = if dt > 0.0 {
+            (end / dt).clamp(0.0, 1.0)
+        } else {
+            1.0
+        };
+        for (s, (a, b)) in state
+            .step_locals
+            .iter_mut()
+            .zip(state.prev_locals.iter().zip(locals))
+        {
+            *s = a.lerp(b, w);
+        }
+        let comp = Transform::from_translation_rotation(
+            state
+                .prev_component
+                .translation
+                .lerp(component.translation, w),
+            slerp_shortest(state.prev_component.rotation, component.rotation, w),
+        );
+        let mut step_locals = std::mem::take(&mut state.step_locals);
+        let mut step_models = std::mem::take(&mut state.step_models);
+        local_to_model(sk, &step_locals, &mut step_models, 0);
+        place_colliders(rig, state, &comp, &step_models);
+        state.rotation_before.copy_from_slice(&state.rotation);
+        update(sk, rig, state, &comp, h, &mut step_locals, &mut step_models);
+        state.step_locals = step_locals;
+        state.step_models = step_models;
+    }
+    state.accumulator = (total - steps as f32 * h).max(0.0);
+}
