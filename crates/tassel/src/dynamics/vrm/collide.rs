@@ -102,6 +102,75 @@ impl PlacedVrmCollider {
         }
     }
 
+    /// Tassel's exact resolution on the bone sphere (fixed mode, after the spec's push):
+    /// the tail at distance `length` from the joint at `pos` that satisfies this collider
+    /// and is nearest to `tail`. The constraint is a cone of directions around the joint
+    /// (`u·a ≥ c`); the tail keeps its direction about the cone's axis. Where no direction
+    /// satisfies it (the joint too deep), the tail points straight out.
+    pub fn settle(&self, pos: Vec3, length: f32, tail: Vec3, r: f32) -> Vec3 {
+        if length <= 0.0 {
+            return tail;
+        }
+        // Returns (axis a, min cosine c).
+        let cone = |q: Vec3, limit: f32, inside: bool| -> Option<(Vec3, f32)> {
+            let d = pos - q;
+            let dl = d.length();
+            if dl < 1e-9 {
+                return None;
+            }
+            let k = (limit * limit - dl * dl - length * length) / (2.0 * length * dl);
+            Some(if inside { (-d / dl, -k) } else { (d / dl, k) })
+        };
+        let constraint = match *self {
+            PlacedVrmCollider::Plane { point, normal } => {
+                Some((normal, (r - (pos - point).dot(normal)) / length))
+            }
+            PlacedVrmCollider::Sphere {
+                center,
+                radius,
+                inside,
+            } => cone(
+                center,
+                if inside {
+                    (radius - r).max(0.0)
+                } else {
+                    radius + r
+                },
+                inside,
+            ),
+            PlacedVrmCollider::Capsule {
+                head,
+                tail: end,
+                radius,
+                inside,
+            } => {
+                let q = crate::math::closest_point_on_segment(tail, head, end);
+                cone(
+                    q,
+                    if inside {
+                        (radius - r).max(0.0)
+                    } else {
+                        radius + r
+                    },
+                    inside,
+                )
+            }
+        };
+        let Some((a, c)) = constraint else {
+            return tail;
+        };
+        let u = normalize_or(tail - pos, a);
+        if u.dot(a) >= c - 1e-6 || c < -1.0 {
+            return tail;
+        }
+        if c >= 1.0 {
+            return pos + a * length;
+        }
+        let side = u - a * u.dot(a);
+        let side = normalize_or(side, a.any_orthonormal_vector());
+        pos + (a * c + side * (1.0 - c * c).sqrt()) * length
+    }
+
     /// How far a tail at `p` with radius `r` violates the collider (≤ 0 when it does not).
     pub fn penetration(&self, p: Vec3, r: f32) -> f32 {
         -self.collision(p, r).1
@@ -161,6 +230,46 @@ mod tests {
         // Before the head.
         let (d, dist) = c.collision(Vec3::new(0.0, -0.2, 0.0), 0.1);
         assert!(d.abs_diff_eq(-Vec3::Y, 1e-6) && (dist + 0.4).abs() < 1e-6);
+    }
+
+    #[test]
+    fn settle_finds_the_nearest_allowed_tail() {
+        // Joint 0.03 above a floor, bone 0.05 hanging straight down through it: the
+        // spec's push along the normal is undone by the length projection; settle tips the
+        // bone just enough (tail 0.02 above the floor for a 0.02 tail radius).
+        let floor = PlacedVrmCollider::Plane {
+            point: Vec3::ZERO,
+            normal: Vec3::Y,
+        };
+        let pos = Vec3::new(0.0, 0.03, 0.0);
+        let t = floor.settle(pos, 0.05, Vec3::new(0.001, -0.02, 0.0), 0.02);
+        assert!(
+            (t.y - 0.02).abs() < 1e-6 && (t.distance(pos) - 0.05).abs() < 1e-6,
+            "{t}"
+        );
+        assert!(t.x > 0.0, "keeps its side: {t}");
+        // Sphere: the result touches radius + r and keeps the bone length.
+        let ball = PlacedVrmCollider::Sphere {
+            center: Vec3::new(0.05, 0.0, 0.0),
+            radius: 0.04,
+            inside: false,
+        };
+        let pos = Vec3::new(0.0, 0.0, 0.0);
+        let t = ball.settle(pos, 0.06, Vec3::new(0.06, 0.0, 0.001), 0.01);
+        assert!(
+            (t.distance(Vec3::new(0.05, 0.0, 0.0)) - 0.05).abs() < 1e-5,
+            "{t}"
+        );
+        assert!((t.length() - 0.06).abs() < 1e-6);
+        // Inside sphere: pulled back to radius − r.
+        let cage = PlacedVrmCollider::Sphere {
+            center: Vec3::ZERO,
+            radius: 0.1,
+            inside: true,
+        };
+        let pos = Vec3::new(0.05, 0.0, 0.0);
+        let t = cage.settle(pos, 0.06, Vec3::new(0.11, 0.0, 0.0), 0.01);
+        assert!((t.length() - 0.09).abs() < 1e-5 && (t.distance(pos) - 0.06).abs() < 1e-5);
     }
 
     #[test]

@@ -204,6 +204,10 @@ impl VrmJob<'_> {
             VrmMode::Spec => 1.0,
             VrmMode::Fixed => (state.accumulator * opts.step_rate).clamp(0.0, 1.0),
         };
+        if opts.mode == VrmMode::Fixed {
+            // This frame's colliders, from the animated pose.
+            place_colliders(rig, state, &component, models);
+        }
         for (i, l) in rig.links.iter().enumerate() {
             locals[l.joint].rotation = if w >= 1.0 {
                 state.rotation[i]
@@ -217,7 +221,72 @@ impl VrmJob<'_> {
             locals,
             models,
         }
-        .run()
+        .run()?;
+        if opts.mode == VrmMode::Fixed && !rig.link_colliders.is_empty() {
+            // The interpolated pose lags a step and may cut through a collider between
+            // two steps: it is pushed out by this frame's colliders like a step's tail.
+            collide_output(skeleton, rig, state, &component, locals, models);
+        }
+        Ok(())
+    }
+}
+
+/// Fixed-mode output pass: each link's tail (from the interpolated pose) pushed out of this
+/// frame's colliders with the spec's push and length projection, the rotation rewritten.
+fn collide_output(
+    sk: &Skeleton,
+    rig: &VrmRig,
+    state: &VrmState,
+    component: &Transform,
+    locals: &mut [Transform],
+    models: &mut [Transform],
+) {
+    let mut stale_from = sk.len();
+    for (i, l) in rig.links.iter().enumerate() {
+        if l.colliders.is_empty() {
+            continue;
+        }
+        if stale_from <= l.joint {
+            refresh(sk, locals, models, stale_from, l.joint);
+            stale_from = l.joint + 1;
+        }
+        let joint_world = *component * models[l.joint];
+        let position = joint_world.translation;
+        let length = state.length[i];
+        let tail = joint_world.transform_point(l.tail_local);
+        let parent_world = match l.parent {
+            Some(p) => *component * models[p],
+            None => *component,
+        };
+        let rest_dir = parent_world.rotation * (l.rest_local.rotation * l.bone_axis);
+        let onto_sphere = |t: Vec3| position + normalize_or(t - position, rest_dir) * length;
+        let mut next = tail;
+        let mut moved = false;
+        for &c in &rig.link_colliders[l.colliders.clone()] {
+            let (dir, dist) = state.placed[c].collision(next, l.hit_radius);
+            if dist < 0.0 {
+                next = onto_sphere(next - dir * dist);
+                moved = true;
+            }
+        }
+        let settled = settle(rig, state, l, position, length, next);
+        moved |= settled != next;
+        next = settled;
+        if !moved {
+            continue;
+        }
+        let rest_world = parent_world * l.rest_local;
+        let to = normalize_or(rest_world.inverse_transform_point(next), l.bone_axis);
+        locals[l.joint].rotation =
+            (l.rest_local.rotation * rotation_arc(l.bone_axis, to)).normalize();
+        models[l.joint] = match l.parent {
+            Some(p) => models[p] * locals[l.joint],
+            None => locals[l.joint],
+        };
+        stale_from = stale_from.min(l.joint + 1);
+    }
+    if stale_from < sk.len() {
+        refresh(sk, locals, models, stale_from, sk.len() - 1);
     }
 }
 
@@ -316,6 +385,9 @@ fn update(
                 next = onto_sphere(next - dir * dist);
             }
         }
+        if rig.options.mode == VrmMode::Fixed {
+            next = settle(rig, state, l, position, length, next);
+        }
 
         let to_stored = |t: Vec3| center.map_or(t, |c| c.inverse_transform_point(t));
         state.prev_tail[i] = state.current_tail[i];
@@ -337,6 +409,39 @@ fn update(
     if stale_from < sk.len() {
         refresh(sk, locals, models, stale_from, sk.len() - 1);
     }
+}
+
+/// Fixed mode: what the spec's single push leaves inside a collider (the length
+/// projection can undo a push) is resolved exactly on the bone sphere, two passes over the
+/// link's colliders.
+fn settle(
+    rig: &VrmRig,
+    state: &VrmState,
+    l: &super::compile::VrmLink,
+    position: Vec3,
+    length: f32,
+    mut tail: Vec3,
+) -> Vec3 {
+    for _ in 0..2 {
+        let mut changed = false;
+        for &c in &rig.link_colliders[l.colliders.clone()] {
+            let placed = &state.placed[c];
+            let before = placed.penetration(tail, l.hit_radius);
+            if before > 0.0 {
+                let t = placed.settle(position, length, tail, l.hit_radius);
+                // Only ever an improvement (a capsule's cone is taken about the axis point
+                // nearest the tail, which can mislead when the joint sits on the axis).
+                if placed.penetration(t, l.hit_radius) < before {
+                    changed |= t != tail;
+                    tail = t;
+                }
+            }
+        }
+        if !changed {
+            break;
+        }
+    }
+    tail
 }
 
 fn refresh(sk: &Skeleton, locals: &[Transform], models: &mut [Transform], from: usize, to: usize) {
