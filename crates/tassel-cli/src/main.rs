@@ -1,4 +1,4 @@
-//! The `tassel` command: `demo`, `simulate`, `sample`, `bench`. Argument parsing, files and printing
+//! The `tassel` command: `demo`, `simulate`, `sample`, `inspect`, `bench`. Argument parsing, files and printing
 //! only; the work is in the `tassel` and `tassel-gltf` crates.
 
 /// `println!` that ignores a closed standard output (`tassel demo | head` must not panic
@@ -12,6 +12,7 @@ macro_rules! say {
 
 mod bench;
 mod demo;
+mod inspect;
 mod output;
 mod picture;
 mod sample;
@@ -40,6 +41,9 @@ enum Command {
     Simulate(simulate::Args),
     /// Sampled (and blended) local and world transforms of every node of a file, as JSON.
     Sample(sample::Args),
+    /// What a file holds: node tree, skins, clips, VRM springs, joints and colliders,
+    /// warnings.
+    Inspect(inspect::Args),
     /// Measure ns per joint-step for 16 chains × 8 joints with 8 colliders.
     Bench(bench::Args),
 }
@@ -51,6 +55,7 @@ fn main() -> ExitCode {
         Command::Simulate(a) => simulate::run(a),
         Command::Bench(a) => bench::run(a),
         Command::Sample(a) => sample::run(a),
+        Command::Inspect(a) => inspect::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

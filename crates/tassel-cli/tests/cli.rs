@@ -354,3 +354,102 @@ fn a_closed_stdout_is_not_a_panic() {
     assert!(dir.join("demo.glb").exists() && dir.join("demo.png").exists());
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn simulate_vrm_follows_the_contract() {
+    let Some(file) = testdata("vrm/smoke_spring.vrm") else {
+        return;
+    };
+    let d = tmp("vrm");
+    let out_file = d.join("s.json");
+    let out = simulate(
+        &[
+            file.to_str().unwrap(),
+            "--motion",
+            "step",
+            "--amp",
+            "0.2",
+            "--axis",
+            "z",
+            "--frames",
+            "90",
+        ],
+        &out_file,
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let doc: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(&out_file).unwrap()).unwrap();
+    // A VRM runs in spec mode by default; the joints are the spring's joints without its
+    // last (tail-only) joint: nodes 19, 20, 21 with tails 20, 21, 22 (from the file).
+    assert_eq!(doc["mode"], "spec");
+    let joints = doc["joints"].as_array().unwrap();
+    let nodes: Vec<u64> = joints.iter().map(|j| j["node"].as_u64().unwrap()).collect();
+    let tails: Vec<u64> = joints
+        .iter()
+        .map(|j| j["tail_node"].as_u64().unwrap())
+        .collect();
+    assert_eq!(nodes, vec![19, 20, 21]);
+    assert_eq!(tails, vec![20, 21, 22]);
+    assert_eq!(joints[0]["name"], "spring_joint_0");
+    // Initial world positions from the file's translations, added up by hand:
+    // hips 0.86 + spine 0.1 + chest 0.1 + neck 0.2 + head 0.1 − 0.05 per spring joint.
+    let initial = &doc["initial"];
+    for (k, y) in [1.31, 1.26, 1.21].iter().enumerate() {
+        let p = &initial["world_pos"][k];
+        assert!((p[1].as_f64().unwrap() - y).abs() < 1e-5, "{p}");
+        let t = &initial["tail_world_pos"][k];
+        assert!((t[1].as_f64().unwrap() - (y - 0.05)).abs() < 1e-5, "{t}");
+    }
+    // The step moved the root 0.2 m along z; the chain swings behind and comes back.
+    let samples = doc["samples"].as_array().unwrap();
+    assert_eq!(samples.len(), 90);
+    assert!((samples[0]["root_pos"][2].as_f64().unwrap() - 0.2).abs() < 1e-6);
+    let tip_z = |s: &serde_json::Value| s["tail_world_pos"][2][2].as_f64().unwrap();
+    let lag = samples.iter().map(|s| 0.2 - tip_z(s)).fold(0.0, f64::max);
+    assert!(lag > 0.01, "the tip did not lag behind the step: {lag}");
+    assert!((tip_z(&samples[89]) - 0.2).abs() < 0.01, "not settled back");
+    // Fixed mode on request.
+    let out = simulate(&[file.to_str().unwrap(), "--mode", "fixed"], &out_file);
+    assert!(out.status.success());
+    let doc: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(&out_file).unwrap()).unwrap();
+    assert_eq!(doc["mode"], "fixed");
+}
+
+#[test]
+fn inspect_lists_vrm_springs_and_clips() {
+    let (Some(vrm), Some(fox)) = (
+        testdata("vrm/springbone_extended_plane_pmed.vrm"),
+        testdata("gltf/Fox.glb"),
+    ) else {
+        return;
+    };
+    let out = tassel().arg("inspect").arg(&vrm).output().unwrap();
+    assert!(out.status.success());
+    let text = String::from_utf8_lossy(&out.stdout);
+    for needle in [
+        "(VRMC_springBone 1.0): 1 spring(s), 3 swinging joint(s), 1 collider(s)",
+        "'spring_joint_0' (node 19) → 'spring_joint_1' (node 20)",
+        "collider 0 on 'head' (node 4): plane through (0.000, -0.080, 0.000) normal (0.000, 1.000, 0.000)",
+        "no specVersion",
+    ] {
+        assert!(text.contains(needle), "missing '{needle}' in:\n{text}");
+    }
+    let out = tassel().arg("inspect").arg(&fox).output().unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    // Fox.glb: 3 clips; Survey is 3.417 s long (its last key time).
+    assert!(text.contains("'Survey': 3.417 s"), "{text}");
+    assert!(text.contains("'Walk'") && text.contains("'Run'"), "{text}");
+    // A truncated file: a clear error and a non-zero exit.
+    let d = tmp("inspect");
+    let cut = d.join("cut.glb");
+    let bytes = std::fs::read(&fox).unwrap();
+    std::fs::write(&cut, &bytes[..bytes.len() / 3]).unwrap();
+    let out = tassel().arg("inspect").arg(&cut).output().unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("cut.glb"));
+}

@@ -166,6 +166,22 @@ pub fn load_slice(bytes: &[u8], base_dir: Option<&Path>, name: &str) -> Result<M
                 skin.index()
             )));
         }
+        // A skin normally hangs from one root; joints whose parent is outside the skin
+        // beyond the first are worth a look (they move with nodes the skin does not list).
+        let roots: Vec<usize> = joints
+            .iter()
+            .copied()
+            .filter(|&j| skeleton.parent(j).is_none_or(|p| !joints.contains(&p)))
+            .collect();
+        for &j in roots.iter().skip(1) {
+            warnings.push(format!(
+                "skin {} ('{}'): joint '{}' has no parent in the skin ({} such joints)",
+                skin.index(),
+                skin.name().unwrap_or(""),
+                skeleton.name(j),
+                roots.len()
+            ));
+        }
         skins.push(SkinInfo {
             name: skin.name().unwrap_or("").to_string(),
             joints,
