@@ -361,3 +361,50 @@ fn same_inputs_same_bits() {
     };
     assert_eq!(run_once(), run_once());
 }
+
+#[test]
+fn a_bone_belongs_to_one_solver() {
+    use tassel::dynamics::chain::ChainSettings;
+    use tassel::dynamics::RigSettings;
+    use tassel::CharacterSim;
+    // A chain rooted at "root" turns "root" toward "head"; a VRM spring on "root" too.
+    let rig = RigSettings {
+        chains: vec![ChainSettings {
+            name: "c".into(),
+            root: "root".into(),
+            ..Default::default()
+        }],
+        ..Default::default()
+    };
+    let bones = VrmSpringBones {
+        springs: vec![spring(
+            VrmJoint {
+                joint: 0,
+                tail: VrmTail::Joint(1),
+                ..Default::default()
+            },
+            vec![],
+        )],
+        ..Default::default()
+    };
+    let e = CharacterSim::with_vrm(one_joint(), &rig, &bones, VrmOptions::default())
+        .expect_err("shared bone")
+        .to_string();
+    assert!(
+        e.contains("bone 'root' is simulated by a VRM spring and by a chain"),
+        "{e}"
+    );
+    // Without the chain it runs, and the spring turns the root.
+    let mut sim = CharacterSim::with_vrm(
+        one_joint(),
+        &RigSettings::default(),
+        &bones,
+        VrmOptions::default(),
+    )
+    .unwrap();
+    let rest = one_joint().rest().to_vec();
+    sim.frame(&rest, Transform::IDENTITY, 0.0).unwrap();
+    let side = Transform::from_translation(Vec3::new(0.5, 0.0, 0.0));
+    let pose = sim.frame(&rest, side, 1.0 / 60.0).unwrap();
+    assert!(pose.locals[0].rotation.angle_between(Quat::IDENTITY) > 1e-3);
+}
