@@ -453,3 +453,20 @@ fn inspect_lists_vrm_springs_and_clips() {
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("cut.glb"));
 }
+
+#[test]
+fn bench_runs_chains_and_vrm_springs() {
+    for extra in [&[][..], &["--vrm", "spec"][..], &["--vrm", "fixed"][..]] {
+        let out = tassel()
+            .args(["bench", "--frames", "20", "--runs", "1"])
+            .args(extra)
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{extra:?}");
+        // 16 chains of 8 joints below their roots: 16 × 7 simulated joints.
+        assert!(
+            String::from_utf8_lossy(&out.stdout).contains("112 simulated joints"),
+            "{extra:?}"
+        );
+    }
+}
