@@ -86,6 +86,15 @@ fn index(v: &Value, at: &str, count: usize, what: &str) -> Result<usize, String>
     Ok(i)
 }
 
+/// An array of indices below `count`, each checked (`at.key[k]` in messages).
+fn indices(v: &Value, key: &str, at: &str, count: usize, what: &str) -> Result<Vec<usize>, String> {
+    array(v, key, at)?
+        .iter()
+        .enumerate()
+        .map(|(k, x)| index(x, &format!("{at}.{key}[{k}]"), count, what))
+        .collect()
+}
+
 fn vec3_array(v: &Value, key: &str, at: &str, default: Vec3) -> Result<Vec3, String> {
     match v.get(key) {
         None | Some(Value::Null) => Ok(default),
@@ -180,18 +189,7 @@ fn read_v1(
         .enumerate()
     {
         let at = format!("VRMC_springBone.colliderGroups[{i}]");
-        let colliders = array(g, "colliders", &at)?
-            .iter()
-            .enumerate()
-            .map(|(k, c)| {
-                index(
-                    c,
-                    &format!("{at}.colliders[{k}]"),
-                    out.colliders.len(),
-                    "collider",
-                )
-            })
-            .collect::<Result<Vec<_>, _>>()?;
+        let colliders = indices(g, "colliders", &at, out.colliders.len(), "collider")?;
         out.collider_groups.push(VrmColliderGroup {
             name: g.get("name").and_then(Value::as_str).unwrap_or("").into(),
             colliders,
@@ -200,18 +198,13 @@ fn read_v1(
     for (i, s) in array(sb, "springs", "VRMC_springBone")?.iter().enumerate() {
         let at = format!("VRMC_springBone.springs[{i}]");
         let name = s.get("name").and_then(Value::as_str).unwrap_or("").into();
-        let collider_groups = array(s, "colliderGroups", &at)?
-            .iter()
-            .enumerate()
-            .map(|(k, g)| {
-                index(
-                    g,
-                    &format!("{at}.colliderGroups[{k}]"),
-                    out.collider_groups.len(),
-                    "collider group",
-                )
-            })
-            .collect::<Result<Vec<_>, _>>()?;
+        let collider_groups = indices(
+            s,
+            "colliderGroups",
+            &at,
+            out.collider_groups.len(),
+            "collider group",
+        )?;
         let center = match s.get("center") {
             None | Some(Value::Null) => None,
             Some(c) => Some(node_to_joint[index(c, &format!("{at}.center"), nodes, "node")?]),
@@ -379,18 +372,13 @@ fn read_v0(
     let mut taken = vec![false; nodes];
     for (i, g) in array(sa, "boneGroups", at0)?.iter().enumerate() {
         let at = format!("{at0}.boneGroups[{i}]");
-        let collider_groups = array(g, "colliderGroups", &at)?
-            .iter()
-            .enumerate()
-            .map(|(k, c)| {
-                index(
-                    c,
-                    &format!("{at}.colliderGroups[{k}]"),
-                    out.collider_groups.len(),
-                    "collider group",
-                )
-            })
-            .collect::<Result<Vec<_>, _>>()?;
+        let collider_groups = indices(
+            g,
+            "colliderGroups",
+            &at,
+            out.collider_groups.len(),
+            "collider group",
+        )?;
         // center −1 (UniVRM's "none") or absent: world space.
         let center = match g.get("center").and_then(Value::as_i64) {
             Some(c) if c >= 0 => {

@@ -2,7 +2,7 @@
 //! per frame (`spec`) or at a fixed rate with interpolation (`fixed`).
 
 use super::collide::PlacedVrmCollider;
-use super::compile::VrmRig;
+use super::compile::{VrmLink, VrmRig};
 use super::settings::VrmMode;
 use crate::error::{Error, Result};
 use crate::math::{normalize_or, rotation_arc, slerp_shortest, Transform};
@@ -184,7 +184,7 @@ impl VrmJob<'_> {
                 VrmMode::Spec => {
                     if dt > 0.0 {
                         place_colliders(rig, state, &component, models);
-                        update(skeleton, rig, state, &component, dt, locals, models);
+                        update(skeleton, rig, state, &component, dt, false, locals, models);
                     }
                     state.rotation_before.copy_from_slice(&state.rotation);
                 }
@@ -251,38 +251,22 @@ fn collide_output(
             stale_from = l.joint + 1;
         }
         let joint_world = *component * models[l.joint];
-        let position = joint_world.translation;
-        let length = state.length[i];
         let tail = joint_world.transform_point(l.tail_local);
-        let parent_world = match l.parent {
-            Some(p) => *component * models[p],
-            None => *component,
-        };
-        let rest_dir = parent_world.rotation * (l.rest_local.rotation * l.bone_axis);
-        let onto_sphere = |t: Vec3| position + normalize_or(t - position, rest_dir) * length;
-        let mut next = tail;
-        let mut moved = false;
-        for &c in &rig.link_colliders[l.colliders.clone()] {
-            let (dir, dist) = state.placed[c].collision(next, l.hit_radius);
-            if dist < 0.0 {
-                next = onto_sphere(next - dir * dist);
-                moved = true;
-            }
-        }
-        let settled = settle(rig, state, l, position, length, next);
-        moved |= settled != next;
-        next = settled;
-        if !moved {
+        let parent_world = parent_world(l, component, models);
+        let (next, acted) = collide_tail(
+            rig,
+            state,
+            l,
+            joint_world.translation,
+            state.length[i],
+            rest_dir(l, &parent_world),
+            tail,
+            true,
+        );
+        if !acted {
             continue;
         }
-        let rest_world = parent_world * l.rest_local;
-        let to = normalize_or(rest_world.inverse_transform_point(next), l.bone_axis);
-        locals[l.joint].rotation =
-            (l.rest_local.rotation * rotation_arc(l.bone_axis, to)).normalize();
-        models[l.joint] = match l.parent {
-            Some(p) => models[p] * locals[l.joint],
-            None => locals[l.joint],
-        };
+        turn_toward(l, &parent_world, next, locals, models);
         stale_from = stale_from.min(l.joint + 1);
     }
     if stale_from < sk.len() {
@@ -303,7 +287,7 @@ fn reset(
     for l in &rig.links {
         locals[l.joint].rotation = l.rest_local.rotation;
     }
-    local_to_model(sk, locals, models, 0);
+    refresh(sk, locals, models, 0, sk.len() - 1);
     for (i, l) in rig.links.iter().enumerate() {
         let world = *component * models[l.joint];
         let tail = world.transform_point(l.tail_local);
@@ -322,15 +306,6 @@ fn reset(
     state.resets += 1;
 }
 
-fn local_to_model(sk: &Skeleton, locals: &[Transform], models: &mut [Transform], from: usize) {
-    for k in from..sk.len() {
-        models[k] = match sk.parent(k) {
-            Some(p) => models[p] * locals[k],
-            None => locals[k],
-        };
-    }
-}
-
 fn place_colliders(
     rig: &VrmRig,
     state: &mut VrmState,
@@ -342,14 +317,17 @@ fn place_colliders(
     }
 }
 
-/// One update of every link with time step `dt` (the specification's procedure):
-/// `models` must be the model pose of `locals`; both are updated as rotations are written.
+/// One update of every link with time step `dt` (the specification's procedure; `exact`:
+/// fixed mode's settling after the pushes): `models` must be the model pose of `locals`;
+/// both are updated as rotations are written.
+#[allow(clippy::too_many_arguments)]
 fn update(
     sk: &Skeleton,
     rig: &VrmRig,
     state: &mut VrmState,
     component: &Transform,
     dt: f32,
+    exact: bool,
     locals: &mut [Transform],
     models: &mut [Transform],
 ) {
@@ -359,10 +337,7 @@ fn update(
         if stale_from <= l.joint {
             refresh(sk, locals, models, stale_from, l.joint);
         }
-        let parent_world = match l.parent {
-            Some(p) => *component * models[p],
-            None => *component,
-        };
+        let parent_world = parent_world(l, component, models);
         let position = (*component * models[l.joint]).translation;
         let center = l.center.map(|c| *component * models[c]);
         let to_world = |t: Vec3| center.map_or(t, |c| c.transform_point(t));
@@ -371,44 +346,91 @@ fn update(
 
         // Verlet: inertia, stiffness toward the rest direction under the current parent,
         // gravity; then back to the bone length.
-        let rest_dir = parent_world.rotation * (l.rest_local.rotation * l.bone_axis);
+        let rest_dir = rest_dir(l, &parent_world);
         let inertia = (current - prev) * (1.0 - l.drag_force);
         let stiffness = rest_dir * (l.stiffness * dt);
         let external = l.gravity * dt;
         let length = state.length[i];
-        let onto_sphere = |t: Vec3| position + normalize_or(t - position, rest_dir) * length;
-        let mut next = onto_sphere(current + inertia + stiffness + external);
-
-        for &c in &rig.link_colliders[l.colliders.clone()] {
-            let (dir, dist) = state.placed[c].collision(next, l.hit_radius);
-            if dist < 0.0 {
-                next = onto_sphere(next - dir * dist);
-            }
-        }
-        if rig.options.mode == VrmMode::Fixed {
-            next = settle(rig, state, l, position, length, next);
-        }
+        let next = position
+            + normalize_or(
+                current + inertia + stiffness + external - position,
+                rest_dir,
+            ) * length;
+        let (next, _) = collide_tail(rig, state, l, position, length, rest_dir, next, exact);
 
         let to_stored = |t: Vec3| center.map_or(t, |c| c.inverse_transform_point(t));
         state.prev_tail[i] = state.current_tail[i];
         state.current_tail[i] = to_stored(next);
-
-        // Rotation: the rest local rotation turned from the bone axis to the tail, seen
-        // from the joint's rest frame under its current parent.
-        let rest_world = parent_world * l.rest_local;
-        let to = normalize_or(rest_world.inverse_transform_point(next), l.bone_axis);
-        let rotation = (l.rest_local.rotation * rotation_arc(l.bone_axis, to)).normalize();
-        state.rotation[i] = rotation;
-        locals[l.joint].rotation = rotation;
-        models[l.joint] = match l.parent {
-            Some(p) => models[p] * locals[l.joint],
-            None => locals[l.joint],
-        };
+        state.rotation[i] = turn_toward(l, &parent_world, next, locals, models);
         stale_from = l.joint + 1;
     }
     if stale_from < sk.len() {
         refresh(sk, locals, models, stale_from, sk.len() - 1);
     }
+}
+
+/// The world transform of the link's parent (the character's at a skeleton root).
+fn parent_world(l: &VrmLink, component: &Transform, models: &[Transform]) -> Transform {
+    match l.parent {
+        Some(p) => *component * models[p],
+        None => *component,
+    }
+}
+
+/// The rest bone direction under the current parent: the spec's stiffness direction.
+fn rest_dir(l: &VrmLink, parent_world: &Transform) -> Vec3 {
+    parent_world.rotation * (l.rest_local.rotation * l.bone_axis)
+}
+
+/// The spec's collision: for each collider of the link, one push and the projection back
+/// to the bone length; with `exact`, what that leaves inside is then settled. Returns the
+/// tail and whether any collider acted.
+#[allow(clippy::too_many_arguments)]
+fn collide_tail(
+    rig: &VrmRig,
+    state: &VrmState,
+    l: &VrmLink,
+    position: Vec3,
+    length: f32,
+    rest_dir: Vec3,
+    mut tail: Vec3,
+    exact: bool,
+) -> (Vec3, bool) {
+    let mut acted = false;
+    for &c in &rig.link_colliders[l.colliders.clone()] {
+        let (dir, dist) = state.placed[c].collision(tail, l.hit_radius);
+        if dist < 0.0 {
+            tail = position + normalize_or(tail - dir * dist - position, rest_dir) * length;
+            acted = true;
+        }
+    }
+    if exact {
+        let settled = settle(rig, state, l, position, length, tail);
+        acted |= settled != tail;
+        tail = settled;
+    }
+    (tail, acted)
+}
+
+/// Turns the link's joint so that its bone points at `tail` (world): the rest local
+/// rotation turned from the bone axis to the tail as seen from the joint's rest frame
+/// under its current parent. Writes the local rotation and the joint's model transform.
+fn turn_toward(
+    l: &VrmLink,
+    parent_world: &Transform,
+    tail: Vec3,
+    locals: &mut [Transform],
+    models: &mut [Transform],
+) -> Quat {
+    let rest_world = *parent_world * l.rest_local;
+    let to = normalize_or(rest_world.inverse_transform_point(tail), l.bone_axis);
+    let rotation = (l.rest_local.rotation * rotation_arc(l.bone_axis, to)).normalize();
+    locals[l.joint].rotation = rotation;
+    models[l.joint] = match l.parent {
+        Some(p) => models[p] * locals[l.joint],
+        None => locals[l.joint],
+    };
+    rotation
 }
 
 /// Fixed mode: what the spec's single push leaves inside a collider (the length
@@ -417,7 +439,7 @@ fn update(
 fn settle(
     rig: &VrmRig,
     state: &VrmState,
-    l: &super::compile::VrmLink,
+    l: &VrmLink,
     position: Vec3,
     length: f32,
     mut tail: Vec3,
@@ -444,6 +466,7 @@ fn settle(
     tail
 }
 
+/// Model transforms `from..=to` recomputed from their parents' and their locals.
 fn refresh(sk: &Skeleton, locals: &[Transform], models: &mut [Transform], from: usize, to: usize) {
     for k in from..=to {
         models[k] = match sk.parent(k) {
@@ -498,10 +521,19 @@ fn run_fixed(
         );
         let mut step_locals = std::mem::take(&mut state.step_locals);
         let mut step_models = std::mem::take(&mut state.step_models);
-        local_to_model(sk, &step_locals, &mut step_models, 0);
+        refresh(sk, &step_locals, &mut step_models, 0, sk.len() - 1);
         place_colliders(rig, state, &comp, &step_models);
         state.rotation_before.copy_from_slice(&state.rotation);
-        update(sk, rig, state, &comp, h, &mut step_locals, &mut step_models);
+        update(
+            sk,
+            rig,
+            state,
+            &comp,
+            h,
+            true,
+            &mut step_locals,
+            &mut step_models,
+        );
         state.step_locals = step_locals;
         state.step_models = step_models;
     }
