@@ -17,6 +17,7 @@
 pub mod anim;
 pub mod builtin;
 pub mod collide;
+pub mod controller;
 pub mod dynamics;
 mod error;
 mod instance;

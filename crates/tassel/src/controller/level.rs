@@ -1,0 +1,465 @@
+//! The static level the character controller moves through: colliders in a parry BVH, with
+//! the queries the controller needs (capsule sweep, ray, contacts). Every collider is split
+//! into primitives (a triangle mesh into its triangles), each a leaf of parry's BVH.
+
+use super::narrow::{Prim, Separation};
+use crate::error::{Error, Result};
+use glam::{Quat, Vec3};
+use parry3d::bounding_volume::{Aabb, BoundingVolume};
+use parry3d::partitioning::{Bvh, BvhBuildStrategy};
+
+/// The geometry of one level collider, in its own frame.
+#[derive(Debug, Clone, PartialEq)]
+pub enum LevelShape {
+    /// A box centred on its origin.
+    Box {
+        /// Half the size along each local axis, metres (> 0).
+        half_extents: Vec3,
+    },
+    /// A sphere centred on its origin.
+    Sphere {
+        /// Radius, metres (> 0).
+        radius: f32,
+    },
+    /// A capsule along the local Y axis, centred on its origin.
+    Capsule {
+        /// Half the length of the axis segment, metres (≥ 0).
+        half_height: f32,
+        /// Radius, metres (> 0).
+        radius: f32,
+    },
+    /// A wedge: the base is the rectangle `x ∈ [-width/2, width/2]`, `z ∈ [0, length]` at
+    /// `y = 0`; the top face rises from the edge `z = 0` to `y = height` at `z = length`,
+    /// where a vertical back face closes it. Slope angle `atan(height / length)`.
+    Ramp {
+        /// Size across, metres (> 0).
+        width: f32,
+        /// Horizontal run, metres (> 0).
+        length: f32,
+        /// Rise, metres (> 0).
+        height: f32,
+    },
+    /// Triangles (e.g. a mesh read from a glTF file), vertices in the collider's frame.
+    /// Either side blocks; a mesh has no inside. Degenerate (zero-area) triangles are skipped.
+    TriMesh {
+        /// Vertex positions.
+        vertices: Vec<Vec3>,
+        /// Three vertex indices per triangle.
+        indices: Vec<[u32; 3]>,
+    },
+}
+
+impl LevelShape {
+    /// A ramp of the given slope angle (radians, in `(0, π/2)`) rising over `length`.
+    pub fn ramp_with_angle(width: f32, length: f32, angle: f32) -> Self {
+        LevelShape::Ramp {
+            width,
+            length,
+            height: length * angle.tan(),
+        }
+    }
+}
+
+/// One static collider of a level: a name (for errors and hit reports), a shape and where
+/// it is.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LevelCollider {
+    /// A name for messages.
+    pub name: String,
+    /// The geometry, in the collider's frame.
+    pub shape: LevelShape,
+    /// World position of the collider's frame, metres.
+    pub position: Vec3,
+    /// World rotation of the collider's frame.
+    pub rotation: Quat,
+}
+
+impl LevelCollider {
+    /// A collider at `position` with no rotation.
+    pub fn new(name: impl Into<String>, shape: LevelShape, position: Vec3) -> Self {
+        Self {
+            name: name.into(),
+            shape,
+            position,
+            rotation: Quat::IDENTITY,
+        }
+    }
+
+    /// The same collider turned by `rotation` about its frame's origin.
+    pub fn rotated(mut self, rotation: Quat) -> Self {
+        self.rotation = rotation;
+        self
+    }
+}
+
+/// A shape-cast hit against the level.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LevelHit {
+    /// Index of the collider hit (the order given to [`Level::new`]).
+    pub collider: usize,
+    /// Fraction of the cast translation travelled before contact, in `[0, 1]`.
+    pub fraction: f32,
+    /// Contact point on the collider, world space.
+    pub point: Vec3,
+    /// Unit normal of the contact, world space, pointing from the collider towards the
+    /// cast shape.
+    pub normal: Vec3,
+}
+
+/// A ray hit against the level.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RayHit {
+    /// Index of the collider hit.
+    pub collider: usize,
+    /// Distance along the (unit) ray direction, metres.
+    pub distance: f32,
+    /// Surface normal at the hit, world space, facing the ray's origin side.
+    pub normal: Vec3,
+}
+
+/// How far a capsule is from one level primitive.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LevelContact {
+    /// Index of the collider.
+    pub collider: usize,
+    /// Signed distance, metres (negative: penetration depth).
+    pub distance: f32,
+    /// Unit direction from the collider towards the capsule (the way out), world space.
+    pub normal: Vec3,
+    /// The closest point on the collider, world space.
+    pub point: Vec3,
+}
+
+/// A static level: colliders split into primitives in a bounding-volume hierarchy
+/// (parry's BVH), built once.
+pub struct Level {
+    colliders: Vec<LevelCollider>,
+    prims: Vec<Prim>,
+    owner: Vec<u32>,
+    bvh: Bvh,
+}
+
+impl std::fmt::Debug for Level {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Level")
+            .field("colliders", &self.colliders.len())
+            .field("primitives", &self.prims.len())
+            .finish()
+    }
+}
+
+/// A convex polyhedron from its faces (each a convex polygon wound counter-clockwise seen
+/// from outside).
+fn convex(faces: &[&[Vec3]]) -> Prim {
+    let mut planes = Vec::new();
+    let mut triangles = Vec::new();
+    for f in faces {
+        let n = (f[1] - f[0]).cross(f[2] - f[0]).normalize();
+        planes.push((n, n.dot(f[0])));
+        for k in 1..f.len() - 1 {
+            triangles.push([f[0], f[k], f[k + 1]]);
+        }
+    }
+    Prim::Convex { planes, triangles }
+}
+
+fn build_prims(c: &LevelCollider, out: &mut Vec<Prim>) -> Result<()> {
+    let bad = |what: String| {
+        Err(Error::InvalidParameter(format!(
+            "level collider '{}': {what}",
+            c.name
+        )))
+    };
+    let positive = |x: f32| x.is_finite() && x > 0.0;
+    let rot = c.rotation.normalize();
+    let world = |p: Vec3| c.position + rot * p;
+    match &c.shape {
+        LevelShape::Box { half_extents: h } => {
+            if !(positive(h.x) && positive(h.y) && positive(h.z)) {
+                return bad(format!("box half extents {h} must be finite and > 0"));
+            }
+            out.push(Prim::Cuboid {
+                centre: c.position,
+                rotation: rot,
+                half: *h,
+            });
+        }
+        LevelShape::Sphere { radius } => {
+            if !positive(*radius) {
+                return bad(format!("sphere radius {radius} must be finite and > 0"));
+            }
+            out.push(Prim::Sphere {
+                centre: c.position,
+                radius: *radius,
+            });
+        }
+        LevelShape::Capsule {
+            half_height,
+            radius,
+        } => {
+            if !(positive(*radius) && half_height.is_finite() && *half_height >= 0.0) {
+                return bad(format!(
+                    "capsule radius {radius} must be > 0 and half height {half_height} ≥ 0"
+                ));
+            }
+            out.push(Prim::Capsule {
+                a: world(Vec3::new(0.0, -half_height, 0.0)),
+                b: world(Vec3::new(0.0, *half_height, 0.0)),
+                radius: *radius,
+            });
+        }
+        LevelShape::Ramp {
+            width,
+            length,
+            height,
+        } => {
+            if !(positive(*width) && positive(*length) && positive(*height)) {
+                return bad(format!(
+                    "ramp width {width}, length {length} and height {height} must be finite and > 0"
+                ));
+            }
+            let (w, l, h) = (0.5 * width, *length, *height);
+            let p = [
+                Vec3::new(-w, 0.0, 0.0),
+                Vec3::new(w, 0.0, 0.0),
+                Vec3::new(-w, 0.0, l),
+                Vec3::new(w, 0.0, l),
+                Vec3::new(-w, h, l),
+                Vec3::new(w, h, l),
+            ]
+            .map(world);
+            out.push(convex(&[
+                &[p[0], p[1], p[3], p[2]],
+                &[p[2], p[3], p[5], p[4]],
+                &[p[0], p[4], p[5], p[1]],
+                &[p[0], p[2], p[4]],
+                &[p[1], p[5], p[3]],
+            ]));
+        }
+        LevelShape::TriMesh { vertices, indices } => {
+            if indices.is_empty() {
+                return bad("triangle mesh has no triangles".into());
+            }
+            if let Some(v) = vertices.iter().find(|v| !v.is_finite()) {
+                return bad(format!("triangle mesh vertex {v} is not finite"));
+            }
+            let before = out.len();
+            for (t, tri) in indices.iter().enumerate() {
+                if let Some(&i) = tri.iter().find(|&&i| i as usize >= vertices.len()) {
+                    return bad(format!(
+                        "triangle {t} names vertex {i}, but the mesh has {} vertices",
+                        vertices.len()
+                    ));
+                }
+                let v = tri.map(|i| world(vertices[i as usize]));
+                let n = (v[1] - v[0]).cross(v[2] - v[0]);
+                if n.length() > 1e-12 {
+                    out.push(Prim::Triangle {
+                        v,
+                        normal: n.normalize(),
+                    });
+                }
+            }
+            if out.len() == before {
+                return bad("every triangle of the mesh is degenerate".into());
+            }
+        }
+    }
+    Ok(())
+}
+
+fn aabb(lo: Vec3, hi: Vec3) -> Aabb {
+    Aabb::new(lo, hi)
+}
+
+/// The capsule's segment: `half_height` along the local Y of `rotation` about `centre`.
+pub(crate) fn segment(centre: Vec3, rotation: Quat, half_height: f32) -> (Vec3, Vec3) {
+    let axis = rotation * Vec3::Y * half_height;
+    (centre - axis, centre + axis)
+}
+
+impl Level {
+    /// Builds a level from `colliders`. Errors name the collider and the problem
+    /// (non-finite placement, a non-positive size, a triangle naming a missing vertex).
+    pub fn new(colliders: Vec<LevelCollider>) -> Result<Self> {
+        let mut prims = Vec::new();
+        let mut owner = Vec::new();
+        for (i, c) in colliders.iter().enumerate() {
+            if !c.position.is_finite() || !c.rotation.is_finite() || c.rotation.length() < 1e-6 {
+                return Err(Error::InvalidParameter(format!(
+                    "level collider '{}': position {} / rotation {} must be finite (rotation non-zero)",
+                    c.name, c.position, c.rotation
+                )));
+            }
+            build_prims(c, &mut prims)?;
+            owner.resize(prims.len(), i as u32);
+        }
+        if prims.len() > u32::MAX as usize / 2 {
+            return Err(Error::InvalidParameter(format!(
+                "level has {} primitives; too many",
+                prims.len()
+            )));
+        }
+        let leaves: Vec<Aabb> = prims
+            .iter()
+            .map(|p| {
+                let (lo, hi) = p.bounds();
+                aabb(lo, hi).loosened(1e-4)
+            })
+            .collect();
+        let bvh = Bvh::from_leaves(BvhBuildStrategy::Binned, &leaves);
+        Ok(Self {
+            colliders,
+            prims,
+            owner,
+            bvh,
+        })
+    }
+
+    /// Number of colliders.
+    pub fn len(&self) -> usize {
+        self.colliders.len()
+    }
+
+    /// True without colliders.
+    pub fn is_empty(&self) -> bool {
+        self.colliders.is_empty()
+    }
+
+    /// Number of primitives (a triangle mesh counts its triangles).
+    pub fn primitive_count(&self) -> usize {
+        self.prims.len()
+    }
+
+    /// The colliders, in the order given.
+    pub fn colliders(&self) -> &[LevelCollider] {
+        &self.colliders
+    }
+
+    /// World-space bounds of collider `i` (min, max); `None` past the end.
+    pub fn bounds(&self, i: usize) -> Option<(Vec3, Vec3)> {
+        let mut out: Option<(Vec3, Vec3)> = None;
+        for (p, &o) in self.prims.iter().zip(&self.owner) {
+            if o as usize == i {
+                let (lo, hi) = p.bounds();
+                out = Some(match out {
+                    None => (lo, hi),
+                    Some((a, b)) => (a.min(lo), b.max(hi)),
+                });
+            }
+        }
+        out
+    }
+
+    /// Sweeps the capsule `a`–`b` of `radius` along `translation` and returns the first
+    /// contact before its end. Contacts the motion leaves or slides along are ignored, so
+    /// a capsule resting on a floor walks on it. Ties go to the lower primitive.
+    pub(crate) fn cast(
+        &self,
+        a: Vec3,
+        b: Vec3,
+        radius: f32,
+        translation: Vec3,
+    ) -> Option<LevelHit> {
+        let (lo, hi) = (a.min(b) - radius, a.max(b) + radius);
+        let swept = aabb(lo.min(lo + translation), hi.max(hi + translation)).loosened(1e-3);
+        let mut best: Option<(f32, u32, Separation)> = None;
+        for leaf in self.bvh.intersect_aabb(&swept) {
+            let Some((t, s)) = self.prims[leaf as usize].sweep(a, b, radius, translation) else {
+                continue;
+            };
+            let better = match &best {
+                None => true,
+                Some((bt, bl, _)) => t < *bt || (t == *bt && leaf < *bl),
+            };
+            if better {
+                best = Some((t, leaf, s));
+            }
+        }
+        best.map(|(t, leaf, s)| LevelHit {
+            collider: self.owner[leaf as usize] as usize,
+            fraction: t.clamp(0.0, 1.0),
+            point: s.point,
+            normal: s.normal,
+        })
+    }
+
+    /// Casts a ray from `origin` along unit `dir` up to `max_distance` metres: the first
+    /// surface it reaches from outside. A ray that starts inside a solid reports nothing
+    /// for that solid.
+    pub fn ray(&self, origin: Vec3, dir: Vec3, max_distance: f32) -> Option<RayHit> {
+        if !(origin.is_finite() && dir.is_finite() && max_distance.is_finite()) {
+            return None;
+        }
+        let dir = dir.normalize_or_zero();
+        if dir == Vec3::ZERO || max_distance <= 0.0 {
+            return None;
+        }
+        let v = dir * max_distance;
+        let bounds = aabb(origin.min(origin + v), origin.max(origin + v)).loosened(1e-3);
+        let mut best: Option<(f32, u32, Vec3)> = None;
+        for leaf in self.bvh.intersect_aabb(&bounds) {
+            let p = &self.prims[leaf as usize];
+            if p.sdf(origin).0 < 0.0 {
+                continue;
+            }
+            let Some((t, s)) = p.sweep(origin, origin, 0.0, v) else {
+                continue;
+            };
+            if best.is_none_or(|(bt, bl, _)| t < bt || (t == bt && leaf < bl)) {
+                best = Some((t, leaf, s.normal));
+            }
+        }
+        best.map(|(t, leaf, normal)| RayHit {
+            collider: self.owner[leaf as usize] as usize,
+            distance: t * max_distance,
+            normal,
+        })
+    }
+
+    /// Every primitive closer to the capsule `a`–`b` of `radius` than `within` metres
+    /// (negative distances are penetrations), in primitive order.
+    pub(crate) fn contacts(
+        &self,
+        a: Vec3,
+        b: Vec3,
+        radius: f32,
+        within: f32,
+        out: &mut Vec<LevelContact>,
+    ) {
+        out.clear();
+        let r = radius + within.max(0.0);
+        let bounds = aabb(a.min(b) - r, a.max(b) + r);
+        for leaf in self.bvh.intersect_aabb(&bounds) {
+            let s = self.prims[leaf as usize].separation(a, b, radius);
+            if s.distance < within {
+                out.push(LevelContact {
+                    collider: self.owner[leaf as usize] as usize,
+                    distance: s.distance,
+                    normal: s.normal,
+                    point: s.point,
+                });
+            }
+        }
+        out.sort_by(|x, y| {
+            x.collider
+                .cmp(&y.collider)
+                .then(x.distance.total_cmp(&y.distance))
+        });
+    }
+
+    /// The deepest penetration of a capsule (`radius`, `half_height` along the local Y of
+    /// `rotation`, centred at `position`) into the level, metres; 0 when it is free.
+    pub fn capsule_penetration(
+        &self,
+        radius: f32,
+        half_height: f32,
+        position: Vec3,
+        rotation: Quat,
+    ) -> f32 {
+        let (a, b) = segment(position, rotation, half_height);
+        let mut out = Vec::new();
+        self.contacts(a, b, radius, 0.0, &mut out);
+        out.iter().map(|p| -p.distance).fold(0.0, f32::max)
+    }
+}
