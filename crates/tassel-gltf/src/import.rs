@@ -35,6 +35,8 @@ pub struct Model {
     pub warnings: Vec<String>,
     /// The file's VRM spring bones (`VRMC_springBone` 1.0 or VRM 0.x), if any.
     pub vrm: Option<crate::VrmInfo>,
+    /// Every triangle-list mesh primitive, placed at rest (e.g. for a controller level).
+    pub meshes: Vec<crate::MeshInstance>,
     /// The parsed JSON and resolved buffers, for export.
     pub source: crate::ExportSource,
 }
@@ -285,7 +287,16 @@ pub fn load_slice(bytes: &[u8], base_dir: Option<&Path>, name: &str) -> Result<M
             .validate_for(&skeleton)
             .map_err(|e| invalid(format!("spring bones: {e}")))?;
     }
+    let meshes = crate::mesh::read_meshes(
+        doc,
+        &buffers,
+        &skeleton,
+        &node_to_joint,
+        &mut warnings,
+        &invalid,
+    )?;
     Ok(Model {
+        meshes,
         skeleton,
         node_to_joint,
         joint_to_node,

@@ -9,9 +9,11 @@
 mod error;
 mod export;
 mod import;
+mod mesh;
 mod vrm;
 
 pub use error::GltfError;
 pub use export::{export_glb, BakedClip, BakedTrack, BoneMesh, ExportSource};
 pub use import::{load, load_slice, Model, SkinInfo};
+pub use mesh::MeshInstance;
 pub use vrm::{read_spring_bones, VrmInfo, VrmVersion, VRM0_TAIL_LENGTH};
