@@ -5,6 +5,7 @@ use crate::picture::{draw, Panel, Series};
 use glam::{Quat, Vec3};
 use std::path::PathBuf;
 use std::time::Instant;
+use tassel::builtin::level::LevelRun;
 use tassel::builtin::{self, DemoScript};
 use tassel::collide::Shape;
 use tassel::dynamics::cloth::ConstraintKind;
@@ -22,7 +23,7 @@ pub struct Args {
     fps: f32,
 }
 
-const MOMENTS: [f32; 6] = [1.0, 3.0, 5.0, 6.15, 7.5, 8.7];
+const MOMENTS: [f32; 6] = [1.0, 4.9, 6.2, 7.3, 9.6, 11.2];
 
 fn chain_color(name: &str) -> [u8; 3] {
     match name.split('_').next().unwrap_or("") {
@@ -44,11 +45,14 @@ pub fn run(a: Args) -> Result<(), String> {
     let c = builtin::character();
     let sk = &c.skeleton;
     let mut sim = CharacterSim::new(sk.clone(), &c.rig).map_err(|e| e.to_string())?;
-    let script = DemoScript;
+    let mut run = LevelRun::new().map_err(|e| e.to_string())?;
     let dt = 1.0 / a.fps;
-    let frames = (DemoScript::DURATION * a.fps).round() as usize;
+    let frames = (LevelRun::DURATION * a.fps).round() as usize;
     let mut locals = sk.rest().to_vec();
-    let mut animator = script.animator(&c);
+    let mut animator = DemoScript.animator(&c);
+    let (mut grounded, mut stepped, mut snapped, mut sliding, mut wall) = (0, 0, 0, 0, 0);
+    let mut move_time = 0.0f64;
+    let mut end = Vec3::ZERO;
     let mut visited: Vec<String> = Vec::new();
     let mut events = 0usize;
     let n = sk.len();
@@ -101,18 +105,28 @@ pub fn run(a: Args) -> Result<(), String> {
     let mut sim_time = 0.0f64;
     for f in 0..=frames {
         let t = f as f32 * dt;
-        let m = script.at(t);
-        let plan = script
-            .pose(
+        let start = Instant::now();
+        let m = run
+            .frame(
                 &c,
                 &mut animator,
-                &m,
+                t,
                 if f == 0 { 0.0 } else { dt },
                 &mut locals,
             )
             .map_err(|e| e.to_string())?;
-        events += plan.events.len();
-        let current = plan.state;
+        move_time += start.elapsed().as_secs_f64();
+        if f > 0 {
+            let mv = &run.last;
+            grounded += mv.grounded as usize;
+            stepped += mv.stepped as usize;
+            snapped += mv.snapped as usize;
+            sliding += mv.sliding as usize;
+            wall += mv.hits.iter().any(|h| h.normal.y.abs() < 0.3) as usize;
+        }
+        events += m.events;
+        end = m.component.translation;
+        let current = m.state;
         let state = animator.machine().state_name(current).to_string();
         if visited.last() != Some(&state) {
             visited.push(state);
@@ -250,12 +264,11 @@ pub fn run(a: Args) -> Result<(), String> {
     .map_err(|e| e.to_string())?;
     let bands = [
         (0.0, [236, 236, 236]),
-        (1.5, [226, 238, 226]),
-        (3.5, [246, 228, 222]),
-        (6.0, [236, 236, 236]),
-        (7.0, [226, 232, 246]),
-        (8.0, [246, 240, 214]),
-        (9.2, [236, 236, 236]),
+        (1.0, [226, 238, 226]),
+        (3.2, [246, 228, 222]),
+        (6.3, [246, 240, 214]),
+        (8.4, [226, 232, 246]),
+        (10.6, [236, 236, 236]),
     ];
     let series: Vec<Series> = tracked
         .iter()
@@ -265,7 +278,7 @@ pub fn run(a: Args) -> Result<(), String> {
             values,
         })
         .collect();
-    let png = draw(&panels, &bands, &series, DemoScript::DURATION).png()?;
+    let png = draw(&panels, &bands, &series, LevelRun::DURATION).png()?;
     let glb_path = a.out.join("demo.glb");
     let png_path = a.out.join("demo.png");
     write_atomic(&glb_path, &glb)?;
@@ -274,11 +287,20 @@ pub fn run(a: Args) -> Result<(), String> {
         + sim.cloths().simulated_joints().count()
         + sim.ropes().simulated_joints().count();
     say!(
-        "tassel demo: idle, walk, run, sudden stop, turn in place, jump ({:.0} s at {} Hz)",
-        DemoScript::DURATION,
+        "tassel demo: walk up stairs, run down a ramp, jump a crate, slide along a wall ({:.1} s at {} Hz)",
+        LevelRun::DURATION,
         a.fps
     );
     say!("  frames: {}", frames + 1);
+    say!(
+        "  controller: {} colliders; grounded {grounded} of {frames} frames, climbing steps on {stepped}, snapped down on {snapped}, sliding on {sliding}, against a wall on {wall}; ends at {:.2}",
+        run.level.len(),
+        end
+    );
+    say!(
+        "  time per frame (state machine, sampling, blending and controller): {:.1} us",
+        move_time * 1e6 / (frames + 1) as f64
+    );
     say!(
         "  chains: {}, cloths: {} ({} points), ropes: {}, springs: {}, joints simulated: {simulated} (of {n}), colliders: {}",
         sim.chains().chain_count(),

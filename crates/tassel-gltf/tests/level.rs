@@ -14,8 +14,7 @@ fn a_capsule_lands_on_a_mesh_read_from_gltf() {
         return;
     };
     let model = tassel_gltf::load(&path).unwrap();
-    let json: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(&path).unwrap()).unwrap();
+    let json: serde_json::Value = serde_json::from_slice(&std::fs::read(&path).unwrap()).unwrap();
     // Node 0 holds mesh 0 at the scene root: translation (0, 2, 0), scale 0.25; its
     // POSITION accessor says the mesh reaches y = max[1].
     let node = &json["nodes"][0];
@@ -34,10 +33,21 @@ fn a_capsule_lands_on_a_mesh_read_from_gltf() {
     let scale = node["scale"][1].as_f64().unwrap() as f32;
     let top = centre.y + scale * max_y;
 
-    let instance = model.meshes.iter().find(|m| m.node == 0).expect("node 0's mesh");
+    let instance = model
+        .meshes
+        .iter()
+        .find(|m| m.node == 0)
+        .expect("node 0's mesh");
     assert_eq!(instance.vertices.len(), count);
-    let highest = instance.vertices.iter().map(|v| v.y).fold(f32::MIN, f32::max);
-    assert!((highest - top).abs() < 1e-5, "mesh top {highest}, file says {top}");
+    let highest = instance
+        .vertices
+        .iter()
+        .map(|v| v.y)
+        .fold(f32::MIN, f32::max);
+    assert!(
+        (highest - top).abs() < 1e-5,
+        "mesh top {highest}, file says {top}"
+    );
 
     let level = Level::new(vec![instance.to_collider()]).unwrap();
     let capsule = CharacterCapsule::with_height(1.8, 0.3);
@@ -49,14 +59,23 @@ fn a_capsule_lands_on_a_mesh_read_from_gltf() {
     for _ in 0..180 {
         vy -= 9.81 * dt;
         let m = settings
-            .move_shape(&level, &capsule, &Transform::from_translation(pos), Vec3::Y * vy * dt, dt)
+            .move_shape(
+                &level,
+                &capsule,
+                &Transform::from_translation(pos),
+                Vec3::Y * vy * dt,
+                dt,
+            )
             .unwrap();
         pos += m.translation;
         grounded = m.grounded;
         if grounded {
             vy = 0.0;
         }
-        assert!(level.capsule_penetration(capsule.radius, capsule.half_height, pos, Quat::IDENTITY) < 1e-4);
+        assert!(
+            level.capsule_penetration(capsule.radius, capsule.half_height, pos, Quat::IDENTITY)
+                < 1e-4
+        );
     }
     assert!(grounded);
     let bottom = pos.y - capsule.half_total_height();

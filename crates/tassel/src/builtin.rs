@@ -26,6 +26,9 @@ pub struct Character {
     pub clips: Vec<Clip>,
 }
 
+#[path = "builtin_level.rs"]
+pub mod level;
+
 /// Index of each clip in [`Character::clips`].
 pub mod clip {
     /// Breathing in place, 2 s loop.

@@ -653,3 +653,69 @@ fn lift_sweep_drop_climbs_a_riser_met_with_the_straight_side() {
     assert!(pos.y < 0.9 + 0.02, "climbed onto a 5 cm ledge: {pos}");
     assert!(pos.x + THIN.radius <= 1.0 + 1e-4, "{pos}");
 }
+
+/// The demo's run through its level (`tassel demo`): up the stairs onto the 0.9 m
+/// platform, down the ramp, over the crate, along the wall, never inside anything.
+#[test]
+fn the_demo_run_climbs_jumps_and_slides_through_its_level() {
+    use tassel::builtin::level::{LevelRun, CRATE, STAIRS};
+    use tassel::builtin::{self, DemoScript};
+    let c = builtin::character();
+    let mut animator = DemoScript.animator(&c);
+    let mut run = LevelRun::new().unwrap();
+    let mut locals = c.skeleton.rest().to_vec();
+    let frames = (LevelRun::DURATION / DT) as usize;
+    let (count, rise, tread, z0) = STAIRS;
+    let top = count as f32 * rise;
+    // The platform past the last stair runs 3.5 m.
+    let platform = z0 + count as f32 * tread + 0.5..z0 + count as f32 * tread + 3.0;
+    let (mut on_platform, mut states) = (0, Vec::new());
+    let mut end = Vec3::ZERO;
+    for f in 0..=frames {
+        let t = f as f32 * DT;
+        let m = run
+            .frame(
+                &c,
+                &mut animator,
+                t,
+                if f == 0 { 0.0 } else { DT },
+                &mut locals,
+            )
+            .unwrap();
+        let feet = m.component.translation;
+        end = feet;
+        if platform.contains(&feet.z) {
+            on_platform += 1;
+            assert!(
+                (feet.y - top).abs() < 2e-3,
+                "t = {t}: feet at {feet} on the platform"
+            );
+        }
+        let name = animator.machine().state_name(m.state).to_string();
+        if states.last() != Some(&name) {
+            states.push(name);
+        }
+        let centre = feet + Vec3::Y * (run.capsule.half_total_height() + run.settings.skin);
+        let depth = run.level.capsule_penetration(
+            run.capsule.radius,
+            run.capsule.half_height,
+            centre,
+            Quat::IDENTITY,
+        );
+        assert!(depth < 1e-3, "t = {t}: {depth} m inside at {feet}");
+        // Over the crate the feet are above its top.
+        if (CRATE.0..CRATE.0 + 0.6).contains(&feet.z) {
+            assert!(feet.y > CRATE.1, "t = {t}: feet at {feet} over the crate");
+        }
+    }
+    assert!(on_platform > 10, "{on_platform} frames on the platform");
+    assert!(
+        states.iter().any(|s| s.starts_with("jump_loop")),
+        "{states:?}"
+    );
+    // Ends pressed against the wall (near face x = 1.2), having slid along it.
+    let x = 1.2 - run.capsule.radius - run.settings.skin;
+    assert!((end.x - x).abs() < 1e-3, "ends at {end}");
+    assert!(end.z > CRATE.0 + 3.0);
+    assert!(run.last.grounded);
+}

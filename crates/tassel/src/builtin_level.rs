@@ -1,0 +1,294 @@
+//! The demo's small level and the run through it: the character controller moves the
+//! built-in character's capsule from player-like input (speed, heading, a jump button);
+//! the locomotion state machine is fed the controller's result (speed, jumping, landing).
+
+use crate::anim::Animator;
+use crate::controller::{
+    CharacterCapsule, ControllerSettings, Level, LevelCollider, LevelShape, Movement,
+};
+use crate::math::Transform;
+use crate::rng::SplitMix64;
+use glam::{Quat, Vec3};
+
+use super::Character;
+
+fn block(name: &str, min: Vec3, max: Vec3) -> LevelCollider {
+    LevelCollider::new(
+        name,
+        LevelShape::Box {
+            half_extents: (max - min) * 0.5,
+        },
+        (max + min) * 0.5,
+    )
+}
+
+/// Stair steps of the demo: count, rise and tread (m), first riser at z.
+pub const STAIRS: (usize, f32, f32, f32) = (5, 0.18, 0.35, 4.5);
+/// The crate jumped over: its near face (z) and height (m).
+pub const CRATE: (f32, f32) = (20.0, 0.35);
+
+/// The demo level along +z: floor; five 0.18 m stairs up to a 0.9 m platform; a 20° ramp
+/// back down; a crate to jump over; a long wall at x = 1.2 m to slide along; a boulder
+/// (sphere), a pillar (capsule) and a rock (triangle mesh) beside the path.
+pub fn demo_level() -> Vec<LevelCollider> {
+    let (count, rise, tread, z0) = STAIRS;
+    let top = count as f32 * rise;
+    let platform_end = z0 + count as f32 * tread + 3.5;
+    let mut c = vec![block(
+        "floor",
+        Vec3::new(-20.0, -1.0, -10.0),
+        Vec3::new(20.0, 0.0, 60.0),
+    )];
+    for i in 0..count {
+        let z = z0 + i as f32 * tread;
+        c.push(block(
+            &format!("stair {i}"),
+            Vec3::new(-1.5, 0.0, z),
+            Vec3::new(1.0, (i + 1) as f32 * rise, platform_end),
+        ));
+    }
+    // A ramp down: the wedge turned to face back, its high edge against the platform.
+    let angle = 20f32.to_radians();
+    let run = top / angle.tan();
+    c.push(
+        LevelCollider::new(
+            "ramp",
+            LevelShape::Ramp {
+                width: 2.5,
+                length: run,
+                height: top,
+            },
+            Vec3::new(-0.25, 0.0, platform_end + run),
+        )
+        .rotated(Quat::from_rotation_y(std::f32::consts::PI)),
+    );
+    c.push(block(
+        "crate",
+        Vec3::new(-1.0, 0.0, CRATE.0),
+        Vec3::new(1.0, CRATE.1, CRATE.0 + 0.6),
+    ));
+    c.push(block(
+        "wall",
+        Vec3::new(1.2, 0.0, 21.0),
+        Vec3::new(1.5, 2.5, 40.0),
+    ));
+    c.push(LevelCollider::new(
+        "boulder",
+        LevelShape::Sphere { radius: 0.8 },
+        Vec3::new(-4.0, 0.3, 8.0),
+    ));
+    c.push(LevelCollider::new(
+        "pillar",
+        LevelShape::Capsule {
+            half_height: 1.2,
+            radius: 0.3,
+        },
+        Vec3::new(-3.0, 1.5, 14.0),
+    ));
+    // A four-sided rock as a triangle mesh.
+    c.push(LevelCollider::new(
+        "rock",
+        LevelShape::TriMesh {
+            vertices: vec![
+                Vec3::new(-0.8, 0.0, -0.8),
+                Vec3::new(0.8, 0.0, -0.8),
+                Vec3::new(0.8, 0.0, 0.8),
+                Vec3::new(-0.8, 0.0, 0.8),
+                Vec3::new(0.0, 0.7, 0.0),
+            ],
+            indices: vec![[0, 4, 1], [1, 4, 2], [2, 4, 3], [3, 4, 0]],
+        },
+        Vec3::new(-3.5, 0.0, 18.0),
+    ));
+    c
+}
+
+/// A level of `count` colliders for benchmarks: the demo level plus seeded boxes, spheres
+/// and capsules scattered over 200 m × 200 m away from the path (x ∈ [−2, 2]).
+pub fn bench_level(count: usize, seed: u64) -> Vec<LevelCollider> {
+    let mut c = demo_level();
+    let mut rng = SplitMix64::new(seed);
+    let mut i = 0;
+    while c.len() < count {
+        let mut x = rng.range_f32(-100.0, 100.0);
+        if x.abs() < 4.0 {
+            x += 8.0f32.copysign(x);
+        }
+        let z = rng.range_f32(-100.0, 100.0);
+        let size = rng.range_f32(0.2, 1.5);
+        let shape = match i % 3 {
+            0 => LevelShape::Box {
+                half_extents: Vec3::new(size, rng.range_f32(0.2, 2.0), size * 0.7),
+            },
+            1 => LevelShape::Sphere { radius: size },
+            _ => LevelShape::Capsule {
+                half_height: size,
+                radius: 0.3 * size,
+            },
+        };
+        let yaw = rng.range_f32(0.0, std::f32::consts::TAU);
+        c.push(
+            LevelCollider::new(format!("scatter {i}"), shape, Vec3::new(x, 0.5 * size, z))
+                .rotated(Quat::from_rotation_y(yaw)),
+        );
+        i += 1;
+    }
+    c
+}
+
+/// Player input over time: `(start s, speed m/s, heading degrees from +z towards +x,
+/// label)`.
+const INPUT: [(f32, f32, f32, &str); 6] = [
+    (0.0, 0.0, 0.0, "idle"),
+    (1.0, 1.4, 0.0, "walk (stairs)"),
+    (3.2, 4.0, 0.0, "run (ramp)"),
+    (6.3, 4.0, 0.0, "jump"),
+    (8.4, 1.4, 45.0, "wall"),
+    (10.6, 0.0, 45.0, "idle"),
+];
+/// The jump button is pressed at this time (while running).
+const JUMP_AT: f32 = 6.3;
+/// Take-off speed, m/s (apex v²/2g ≈ 0.8 m).
+const TAKE_OFF: f32 = 4.0;
+/// Gravity, m/s².
+const GRAVITY: f32 = 9.81;
+
+/// The demo's run through [`demo_level`]: player input → controller → state machine.
+pub struct LevelRun {
+    /// The level.
+    pub level: Level,
+    /// The character's capsule (1.7 m, radius 0.28 m).
+    pub capsule: CharacterCapsule,
+    /// Controller settings (defaults).
+    pub settings: ControllerSettings,
+    centre: Vec3,
+    yaw: f32,
+    vy: f32,
+    grounded: bool,
+    jumping: bool,
+    airborne: bool,
+    /// The last movement.
+    pub last: Movement,
+}
+
+/// What one frame of the run produced.
+#[derive(Debug, Clone)]
+pub struct RunFrame {
+    /// The character's world transform (feet on the ground).
+    pub component: Transform,
+    /// The input phase.
+    pub phase: &'static str,
+    /// Input speed, m/s.
+    pub speed: f32,
+    /// The state machine's current state.
+    pub state: usize,
+    /// Events the state machine fired this frame.
+    pub events: usize,
+}
+
+impl LevelRun {
+    /// Length of the run, seconds.
+    pub const DURATION: f32 = 11.5;
+
+    /// The run at its start, standing on the floor.
+    pub fn new() -> crate::Result<Self> {
+        let capsule = CharacterCapsule::with_height(1.7, 0.28);
+        let settings = ControllerSettings::default();
+        Ok(Self {
+            level: Level::new(demo_level())?,
+            centre: Vec3::new(0.0, capsule.half_total_height() + settings.skin, 0.0),
+            capsule,
+            settings,
+            yaw: 0.0,
+            vy: 0.0,
+            grounded: true,
+            jumping: false,
+            airborne: false,
+            last: Movement::default(),
+        })
+    }
+
+    /// The input at `t`: (speed, heading radians, phase label).
+    pub fn input(t: f32) -> (f32, f32, &'static str) {
+        let s = INPUT
+            .iter()
+            .rev()
+            .find(|s| t >= s.0)
+            .copied()
+            .unwrap_or(INPUT[0]);
+        (s.1, s.2.to_radians(), s.3)
+    }
+
+    /// One frame: sets the state machine's parameters from the input and the controller's
+    /// last result, advances `animator` into `locals`, then moves the capsule (gravity
+    /// and the jump's take-off applied here, as a game would) and returns where the
+    /// character is. `dt = 0` (the first frame) only poses.
+    pub fn frame(
+        &mut self,
+        c: &Character,
+        animator: &mut Animator,
+        t: f32,
+        dt: f32,
+        locals: &mut [Transform],
+    ) -> crate::Result<RunFrame> {
+        let (speed, heading, phase) = Self::input(t);
+        // The button is held from the press until the landing after take-off.
+        if t >= JUMP_AT && !self.jumping && !self.airborne && self.grounded && t < JUMP_AT + 0.5 {
+            self.jumping = true;
+        }
+        if let (Some(s), Some(j)) = (
+            animator.machine().param("speed"),
+            animator.machine().param("jumping"),
+        ) {
+            animator.state.set(s, speed);
+            animator.state.set(j, if self.jumping { 1.0 } else { 0.0 });
+        }
+        let plan = animator.update(&c.clips, c.skeleton.rest(), dt, locals)?;
+        let (state_index, events) = (plan.state, plan.events.len());
+        let state = animator.machine().state_name(state_index);
+        if self.jumping && !self.airborne && state.starts_with("jump_loop") {
+            // The jump_start clip has ended: leave the ground.
+            self.vy = TAKE_OFF;
+            self.airborne = true;
+        }
+        if dt > 0.0 {
+            // Turn towards the heading at up to 3 rad/s.
+            let turn = (heading - self.yaw).clamp(-3.0 * dt, 3.0 * dt);
+            self.yaw += turn;
+            if self.grounded && !self.airborne {
+                self.vy = 0.0;
+            }
+            self.vy -= GRAVITY * dt;
+            let forward = Quat::from_rotation_y(self.yaw) * Vec3::Z;
+            let desired = forward * speed * dt + Vec3::Y * self.vy * dt;
+            let m = self.settings.move_shape(
+                &self.level,
+                &self.capsule,
+                &Transform::from_translation(self.centre),
+                desired,
+                dt,
+            )?;
+            self.centre += m.translation;
+            self.grounded = m.grounded;
+            if m.grounded && self.vy <= 0.0 {
+                self.vy = 0.0;
+                if self.airborne {
+                    self.airborne = false;
+                    self.jumping = false;
+                }
+            } else if self.vy > 0.0 && m.translation.y < 0.5 * desired.y {
+                // A ceiling stopped the rise.
+                self.vy = 0.0;
+            }
+            self.last = m;
+        }
+        let feet = self.centre - Vec3::Y * (self.capsule.half_total_height() + self.settings.skin);
+        Ok(RunFrame {
+            component: Transform::from_translation_rotation(feet, Quat::from_rotation_y(self.yaw)),
+            phase,
+            speed,
+            state: state_index,
+            events,
+        })
+    }
+}
