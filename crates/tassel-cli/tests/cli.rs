@@ -65,11 +65,15 @@ fn demo_writes_valid_files_and_is_deterministic() {
         );
         let text = String::from_utf8_lossy(&out.stdout);
         assert!(text.contains("joints simulated"), "{text}");
-        // The script's idle, walk, run, stop, turn and jump, as the seed's graph sees them.
+        // The run's idle, walk, run, running jump, walk and stop, as the seed's graph
+        // sees them.
         assert!(
-            text.contains("states: idle > walk_run > idle > jump_start_from_idle > jump_loop_from_idle > jump_end_from_idle > idle"),
+            text.contains("states: idle > walk_run > jump_start_from_walk_run > jump_loop_from_walk_run > jump_end_from_walk_run > walk_run > idle"),
             "{text}"
         );
+        // It ends pressed against the wall: its face at x = 1.2 m, minus the capsule's
+        // 0.28 m radius and the 0.01 m skin.
+        assert!(text.contains("ends at [0.91, 0.00, "), "{text}");
     }
     let glb = std::fs::read(a.join("demo.glb")).unwrap();
     assert_eq!(
