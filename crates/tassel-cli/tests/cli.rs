@@ -89,14 +89,14 @@ fn demo_writes_valid_files_and_is_deterministic() {
     if let Some(report) = validate(&a.join("demo.glb")) {
         assert!(report.contains("\"errors\":0"), "{report}");
     }
-    // The baked clip has one key per frame: 10 s at 60 Hz = 601 keys.
+    // The baked clip has one key per frame: 11.5 s at 60 Hz = 691 keys.
     let json_len = u32::from_le_bytes(glb[12..16].try_into().unwrap()) as usize;
     let doc: serde_json::Value = serde_json::from_slice(&glb[20..20 + json_len]).unwrap();
     let input = doc["animations"][0]["samplers"][0]["input"]
         .as_u64()
         .unwrap() as usize;
-    assert_eq!(doc["accessors"][input]["count"], 601);
-    assert!((doc["accessors"][input]["max"][0].as_f64().unwrap() - 10.0).abs() < 1e-4);
+    assert_eq!(doc["accessors"][input]["count"], 691);
+    assert!((doc["accessors"][input]["max"][0].as_f64().unwrap() - 11.5).abs() < 1e-4);
 }
 
 fn simulate(args: &[&str], out: &Path) -> std::process::Output {
