@@ -384,6 +384,28 @@ impl Level {
         })
     }
 
+    /// Sweeps a capsule (`radius`, `half_height` along the local Y of `rotation`, centred
+    /// at `position`) along `translation`: the first contact, if any, before its end.
+    pub fn sweep_capsule(
+        &self,
+        radius: f32,
+        half_height: f32,
+        position: Vec3,
+        rotation: Quat,
+        translation: Vec3,
+    ) -> Option<LevelHit> {
+        let finite = radius.is_finite()
+            && half_height.is_finite()
+            && position.is_finite()
+            && rotation.is_finite()
+            && translation.is_finite();
+        if !finite || rotation.length() < 1e-6 {
+            return None;
+        }
+        let (a, b) = segment(position, rotation.normalize(), half_height.max(0.0));
+        self.cast(a, b, radius.max(0.0), translation)
+    }
+
     /// Casts a ray from `origin` along unit `dir` up to `max_distance` metres: the first
     /// surface it reaches from outside. A ray that starts inside a solid reports nothing
     /// for that solid.
