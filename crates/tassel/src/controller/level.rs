@@ -268,10 +268,6 @@ fn build_prims(c: &LevelCollider, out: &mut Vec<Prim>) -> Result<()> {
     Ok(())
 }
 
-fn aabb(lo: Vec3, hi: Vec3) -> Aabb {
-    Aabb::new(lo, hi)
-}
-
 /// The capsule's segment: `half_height` along the local Y of `rotation` about `centre`.
 pub(crate) fn segment(centre: Vec3, rotation: Quat, half_height: f32) -> (Vec3, Vec3) {
     let axis = rotation * Vec3::Y * half_height;
@@ -304,7 +300,7 @@ impl Level {
             .iter()
             .map(|p| {
                 let (lo, hi) = p.bounds();
-                aabb(lo, hi).loosened(1e-4)
+                Aabb::new(lo, hi).loosened(1e-4)
             })
             .collect();
         let bvh = Bvh::from_leaves(BvhBuildStrategy::Binned, &leaves);
@@ -362,7 +358,7 @@ impl Level {
         translation: Vec3,
     ) -> Option<LevelHit> {
         let (lo, hi) = (a.min(b) - radius, a.max(b) + radius);
-        let swept = aabb(lo.min(lo + translation), hi.max(hi + translation)).loosened(1e-3);
+        let swept = Aabb::new(lo.min(lo + translation), hi.max(hi + translation)).loosened(1e-3);
         let mut best: Option<(f32, u32, Separation)> = None;
         for leaf in self.bvh.intersect_aabb(&swept) {
             let Some((t, s)) = self.prims[leaf as usize].sweep(a, b, radius, translation) else {
@@ -418,7 +414,7 @@ impl Level {
             return None;
         }
         let v = dir * max_distance;
-        let bounds = aabb(origin.min(origin + v), origin.max(origin + v)).loosened(1e-3);
+        let bounds = Aabb::new(origin.min(origin + v), origin.max(origin + v)).loosened(1e-3);
         let mut best: Option<(f32, u32, Vec3)> = None;
         for leaf in self.bvh.intersect_aabb(&bounds) {
             let p = &self.prims[leaf as usize];
@@ -451,7 +447,7 @@ impl Level {
     ) {
         out.clear();
         let r = radius + within.max(0.0);
-        let bounds = aabb(a.min(b) - r, a.max(b) + r);
+        let bounds = Aabb::new(a.min(b) - r, a.max(b) + r);
         for leaf in self.bvh.intersect_aabb(&bounds) {
             let s = self.prims[leaf as usize].separation(a, b, radius);
             if s.distance < within {

@@ -5,8 +5,8 @@
 //! One call, in order:
 //! 1. **Keep the skin**: a capsule inside geometry, or closer to it than `skin`, is pushed
 //!    out to the skin gap (straight up off walkable ground, along the normal otherwise).
-//! 2. **Ground at the start** (a short downward sweep): stepping and snapping only happen
-//!    for a character that stood on walkable ground.
+//! 2. **Ground at the start** (contacts within two skins): stepping and snapping only
+//!    happen for a character that stood on walkable ground.
 //! 3. **Collide and slide**: sweep the remaining motion; stop `skin` short of the first
 //!    contact (measured along its normal); re-aim the rest along the contact, per surface
 //!    kind (walkable floor, steep slope, wall, ceiling); corners keep the crease direction;
@@ -130,17 +130,41 @@ impl Mover<'_> {
 
     /// A steep contact that is really the edge of walkable ground: low on the capsule
     /// (within a step's height of its bottom), facing up, with a walkable surface just
-    /// beyond it.
-    fn is_edge_floor(&self, pos: Vec3, hit: &LevelHit) -> bool {
+    /// beyond it. Returns that surface's normal.
+    fn edge_floor(&self, pos: Vec3, hit: &LevelHit) -> Option<Vec3> {
         let rise = hit.normal.dot(self.up);
         if self.walkable(hit.normal) || rise <= 1e-4 {
-            return false;
+            return None;
         }
         let height = (hit.point - pos).dot(self.up) + self.bottom;
-        height <= self.s.max_step_height + self.s.skin
-            && self
-                .surface_normal(pos, hit)
-                .is_some_and(|n| self.walkable(n))
+        if height > self.s.max_step_height + self.s.skin {
+            return None;
+        }
+        self.surface_normal(pos, hit).filter(|&n| self.walkable(n))
+    }
+
+    /// What a contact `distance` away is to stand on: walkable by its own normal, a step's
+    /// edge (walkable, with the surface beyond as its normal), or not walkable.
+    fn classify(&self, pos: Vec3, hit: &LevelHit, distance: f32) -> Ground {
+        if self.walkable(hit.normal) {
+            return Ground {
+                distance,
+                normal: hit.normal,
+                walkable: true,
+            };
+        }
+        match self.edge_floor(pos, hit) {
+            Some(normal) => Ground {
+                distance,
+                normal,
+                walkable: true,
+            },
+            None => Ground {
+                distance,
+                normal: hit.normal,
+                walkable: false,
+            },
+        }
     }
 
     /// How far the capsule must rise, after moving `horizontal`, for its lower sphere to
@@ -180,29 +204,7 @@ impl Mover<'_> {
                 point: c.point,
                 normal: c.normal,
             };
-            let g = if self.walkable(c.normal) {
-                Ground {
-                    distance: c.distance,
-                    normal: c.normal,
-                    walkable: true,
-                }
-            } else if let Some(n) = self
-                .is_edge_floor(pos, &hit)
-                .then(|| self.surface_normal(pos, &hit))
-                .flatten()
-            {
-                Ground {
-                    distance: c.distance,
-                    normal: n,
-                    walkable: true,
-                }
-            } else {
-                Ground {
-                    distance: c.distance,
-                    normal: c.normal,
-                    walkable: false,
-                }
-            };
+            let g = self.classify(pos, &hit, c.distance);
             let better = match &best {
                 None => true,
                 Some(o) => {
@@ -221,29 +223,7 @@ impl Mover<'_> {
     /// Sweeps down by `reach` and classifies what is there.
     fn ground(&self, pos: Vec3, reach: f32) -> Option<Ground> {
         let hit = self.cast(pos, -self.up * reach)?;
-        let distance = hit.fraction * reach;
-        if self.walkable(hit.normal) {
-            return Some(Ground {
-                distance,
-                normal: hit.normal,
-                walkable: true,
-            });
-        }
-        // A contact on the rounded bottom may be a step's edge: the surface beyond decides.
-        if self.is_edge_floor(pos, &hit) {
-            if let Some(n) = self.surface_normal(pos, &hit) {
-                return Some(Ground {
-                    distance,
-                    normal: n,
-                    walkable: true,
-                });
-            }
-        }
-        Some(Ground {
-            distance,
-            normal: hit.normal,
-            walkable: false,
-        })
+        Some(self.classify(pos, &hit, hit.fraction * reach))
     }
 
     /// Pushes the capsule out of anything closer than the skin: straight up off walkable
@@ -413,7 +393,7 @@ impl ControllerSettings {
 
             let rise = n.dot(up);
             let horizontal = remaining - m.vertical(remaining);
-            let edge = m.is_edge_floor(pos, &hit);
+            let edge = m.edge_floor(pos, &hit).is_some();
             // A steep obstacle met while grounded and walked into: try it as a step.
             if was_grounded && !edge && rise < m.cos_climb && rise > -0.1 && horizontal.dot(n) < 0.0
             {

@@ -8,6 +8,7 @@
 //! capsule's segment is found by a golden-section search, and the sweep is Newton's method
 //! on a convex function of time, whose tangents never overshoot the first contact.
 
+use crate::math::{closest_point_on_segment, normalize_or};
 use glam::{Quat, Vec3};
 
 /// One level primitive, world space.
@@ -49,8 +50,11 @@ pub(crate) struct Separation {
     pub point: Vec3,
 }
 
-/// Ericson's closest point on triangle `abc` to `p`.
-pub(crate) fn closest_on_triangle(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> Vec3 {
+/// Ericson's closest point on triangle `abc` to `p`. Same regions as
+/// [`crate::math::closest_point_on_triangle`], but the interior case multiplies by the
+/// reciprocal of the denominator; switching to the shared one moves the controller's
+/// output by an ulp, so it is left for a commit that may change output.
+fn closest_on_triangle(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> Vec3 {
     let (ab, ac, ap) = (b - a, c - a, p - a);
     let (d1, d2) = (ab.dot(ap), ac.dot(ap));
     if d1 <= 0.0 && d2 <= 0.0 {
@@ -80,25 +84,6 @@ pub(crate) fn closest_on_triangle(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> Vec3 {
     }
     let denom = 1.0 / (va + vb + vc);
     a + ab * (vb * denom) + ac * (vc * denom)
-}
-
-fn closest_on_segment(p: Vec3, a: Vec3, b: Vec3) -> Vec3 {
-    let ab = b - a;
-    let l2 = ab.length_squared();
-    if l2 <= 0.0 {
-        return a;
-    }
-    a + ab * ((p - a).dot(ab) / l2).clamp(0.0, 1.0)
-}
-
-/// Unit `v`, or `fallback` when `v` is (nearly) zero.
-fn unit_or(v: Vec3, fallback: Vec3) -> Vec3 {
-    let l = v.length();
-    if l > 1e-12 {
-        v / l
-    } else {
-        fallback
-    }
 }
 
 impl Prim {
@@ -162,11 +147,11 @@ impl Prim {
             }
             Prim::Sphere { centre, radius } => {
                 let v = p - *centre;
-                (v.length() - radius, unit_or(v, Vec3::Y))
+                (v.length() - radius, normalize_or(v, Vec3::Y))
             }
             Prim::Capsule { a, b, radius } => {
-                let v = p - closest_on_segment(p, *a, *b);
-                (v.length() - radius, unit_or(v, Vec3::Y))
+                let v = p - closest_point_on_segment(p, *a, *b);
+                (v.length() - radius, normalize_or(v, Vec3::Y))
             }
             Prim::Convex { planes, triangles } => {
                 let (mut best, mut normal) = (f32::NEG_INFINITY, Vec3::Y);
@@ -191,7 +176,7 @@ impl Prim {
                     }
                 }
                 let v = p - closest;
-                (d2.sqrt(), unit_or(v, normal))
+                (d2.sqrt(), normalize_or(v, normal))
             }
             Prim::Triangle { v, normal } => {
                 let c = closest_on_triangle(p, v[0], v[1], v[2]);
@@ -201,7 +186,7 @@ impl Prim {
                 } else {
                     -*normal
                 };
-                (d.length(), unit_or(d, side))
+                (d.length(), normalize_or(d, side))
             }
         }
     }
@@ -211,7 +196,7 @@ impl Prim {
         let (t, (d, n)) = match self {
             // Closed form for the sphere: the nearest point of the segment to its centre.
             Prim::Sphere { centre, .. } => {
-                let q = closest_on_segment(*centre, a, b);
+                let q = closest_point_on_segment(*centre, a, b);
                 (q, self.sdf(q))
             }
             _ => {
