@@ -259,6 +259,7 @@ pub fn run(a: Args) -> Result<(), String> {
             name: "demo".into(),
             times,
             tracks,
+            merge_into: None,
         }],
     )
     .map_err(|e| e.to_string())?;

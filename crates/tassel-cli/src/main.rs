@@ -1,4 +1,4 @@
-//! The `tassel` command: `demo`, `simulate`, `sample`, `inspect`, `bench`. Argument parsing, files and printing
+//! The `tassel` command: `demo`, `simulate`, `sample`, `inspect`, `bake`, `bench`. Argument parsing, files and printing
 //! only; the work is in the `tassel` and `tassel-gltf` crates.
 
 /// `println!` that ignores a closed standard output (`tassel demo | head` must not panic
@@ -10,11 +10,13 @@ macro_rules! say {
     }};
 }
 
+mod bake;
 mod bench;
 mod demo;
 mod inspect;
 mod output;
 mod picture;
+mod progress;
 mod sample;
 mod simulate;
 
@@ -44,6 +46,9 @@ enum Command {
     /// What a file holds: node tree, skins, clips, VRM springs, joints and colliders,
     /// warnings.
     Inspect(inspect::Args),
+    /// Bake secondary motion into a model's clips: play each clip, run the file's VRM
+    /// springs and the rig's chains, springs and cloths, write a GLB with the clips keyed.
+    Bake(bake::Args),
     /// Measure ns per joint-step for 16 chains × 8 joints with 8 colliders.
     Bench(bench::Args),
 }
@@ -54,6 +59,7 @@ fn main() -> ExitCode {
         Command::Demo(a) => demo::run(a),
         Command::Simulate(a) => simulate::run(a),
         Command::Bench(a) => bench::run(a),
+        Command::Bake(a) => bake::run(a),
         Command::Sample(a) => sample::run(a),
         Command::Inspect(a) => inspect::run(a),
     };

@@ -4,16 +4,25 @@ use crate::output::write_atomic;
 use glam::{Quat, Vec3};
 use serde_json::json;
 use std::path::PathBuf;
-use tassel::dynamics::chain::TimeMode;
-use tassel::dynamics::vrm::{VrmMode, VrmOptions};
-use tassel::dynamics::RigSettings;
+use tassel::dynamics::{RigSettings, SimMode};
 use tassel::{builtin, CharacterSim, Transform};
 
+/// `--mode` on the command line.
 #[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-enum Mode {
+pub enum Mode {
     Spec,
     Fixed,
     Classic,
+}
+
+impl From<Mode> for SimMode {
+    fn from(m: Mode) -> SimMode {
+        match m {
+            Mode::Spec => SimMode::Spec,
+            Mode::Fixed => SimMode::Fixed,
+            Mode::Classic => SimMode::Classic,
+        }
+    }
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -90,7 +99,7 @@ fn root_motion(a: &Args, t: f32) -> Transform {
     }
 }
 
-fn read_rig(path: &PathBuf) -> Result<RigSettings, String> {
+pub fn read_rig(path: &PathBuf) -> Result<RigSettings, String> {
     let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
     RigSettings::from_toml_str(&text).map_err(|e| format!("{}: {e}", path.display()))
 }
@@ -150,45 +159,9 @@ pub fn run(a: Args) -> Result<(), String> {
         }
     };
     let vrm = vrm.unwrap_or_default();
-    let has_vrm = !vrm.is_empty();
-    let mode = match a.mode {
-        Some(m) => m,
-        None if has_vrm => Mode::Spec,
-        None => match rig.chains.first().map(|c| c.mode) {
-            Some(TimeMode::Classic) => Mode::Classic,
-            _ => Mode::Fixed,
-        },
-    };
-    let mode_name = match mode {
-        Mode::Spec => "spec",
-        Mode::Fixed => "fixed",
-        Mode::Classic => "classic",
-    };
-    if mode == Mode::Spec && !has_vrm {
-        return Err(
-            "--mode spec is the VRM spring-bone mode and this model has no VRM springs; use fixed or classic"
-                .into(),
-        );
-    }
-    // spec: VRM springs by the specification, chains keep the rig's mode; fixed: both
-    // fixed; classic: chains classic, VRM springs spec (the frame-rate-dependent pair).
-    if a.mode.is_some() && mode != Mode::Spec {
-        for c in &mut rig.chains {
-            c.mode = if mode == Mode::Classic {
-                TimeMode::Classic
-            } else {
-                TimeMode::Fixed
-            };
-        }
-    }
-    let options = VrmOptions {
-        mode: if mode == Mode::Fixed {
-            VrmMode::Fixed
-        } else {
-            VrmMode::Spec
-        },
-        ..VrmOptions::default()
-    };
+    let (mode, options) = SimMode::apply(a.mode.map(Mode::into), &mut rig, !vrm.is_empty())
+        .map_err(|e| format!("--mode: {e}"))?;
+    let mode_name = mode.name();
     let mut sim =
         CharacterSim::with_vrm(skeleton.clone(), &rig, &vrm, options).map_err(|e| e.to_string())?;
     let mut joints: Vec<(usize, Tail)> = sim

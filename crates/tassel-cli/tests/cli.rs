@@ -1,57 +1,10 @@
 //! The `tassel` binary end to end: demo output validity and determinism, the simulate
 //! contract, and bad input (clear error, non-zero exit, no output file).
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+mod common;
 
-fn tassel() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_tassel"))
-}
-
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("tassel-cli-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn testdata(rel: &str) -> Option<PathBuf> {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/testdata");
-    if root.is_dir() {
-        return Some(root.join(rel));
-    }
-    if std::env::var_os("TASSEL_REQUIRE_TESTDATA").is_some() {
-        panic!("../shared/testdata is missing (TASSEL_REQUIRE_TESTDATA is set)");
-    }
-    eprintln!("SKIPPED: ../shared/testdata is missing; {rel} not tested");
-    None
-}
-
-fn validate(file: &Path) -> Option<String> {
-    let tools = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tools");
-    if !tools.join("node_modules/gltf-validator").is_dir() {
-        if std::env::var_os("TASSEL_REQUIRE_VALIDATOR").is_some() {
-            panic!("gltf-validator is not installed: run `npm ci` in tools/");
-        }
-        eprintln!(
-            "SKIPPED: gltf-validator not installed; {} not validated",
-            file.display()
-        );
-        return None;
-    }
-    let out = Command::new("node")
-        .arg(tools.join("validate.mjs"))
-        .arg(file)
-        .output()
-        .unwrap();
-    let text = String::from_utf8_lossy(&out.stdout).to_string();
-    assert!(
-        out.status.success(),
-        "validator found errors in {}: {text}",
-        file.display()
-    );
-    Some(text)
-}
+use common::{tassel, testdata, tmp, validate};
+use std::path::Path;
 
 #[test]
 fn demo_writes_valid_files_and_is_deterministic() {

@@ -44,12 +44,16 @@ pub struct BakedTrack {
 /// A baked clip: LINEAR keys at `times`.
 #[derive(Debug, Clone, Default)]
 pub struct BakedClip {
-    /// Name; an input animation of the same name is replaced.
+    /// Name; without `merge_into`, an input animation of the same name is replaced.
     pub name: String,
     /// Key times, strictly increasing, seconds.
     pub times: Vec<f32>,
     /// Tracks.
     pub tracks: Vec<BakedTrack>,
+    /// `Some(a)`: the keys go into the input's animation `a` in place (its name and index
+    /// kept): its channels on the nodes and properties these tracks key are replaced, every
+    /// other channel is kept as it was. `None`: a whole animation, added at the end.
+    pub merge_into: Option<usize>,
 }
 
 impl ExportSource {
@@ -317,12 +321,39 @@ pub fn export_glb(source: &ExportSource, clips: &[BakedClip]) -> Result<Vec<u8>,
         .and_then(Value::as_array)
         .map(|a| a.len())
         .unwrap_or(0);
+    let anim_count = out
+        .json
+        .get("animations")
+        .and_then(Value::as_array)
+        .map(|a| a.len())
+        .unwrap_or(0);
+    for clip in clips {
+        if let Some(a) = clip.merge_into {
+            if a >= anim_count {
+                return Err(invalid(format!(
+                    "clip '{}' merges into animation {a}, which does not exist",
+                    clip.name
+                )));
+            }
+            if clips.iter().filter(|c| c.merge_into == Some(a)).count() > 1 {
+                return Err(invalid(format!("two clips merge into animation {a}")));
+            }
+        }
+    }
+    // Merged animations lose the channels they re-key; whole clips replace input
+    // animations of the same name (marked null here, removed at the end so that the
+    // indices of the merged ones hold meanwhile).
     if let Some(anims) = out.json.get_mut("animations").and_then(Value::as_array_mut) {
-        anims.retain(|a| {
-            !clips
-                .iter()
-                .any(|c| a.get("name").and_then(Value::as_str) == Some(c.name.as_str()))
-        });
+        for (a, anim) in anims.iter_mut().enumerate() {
+            if let Some(clip) = clips.iter().find(|c| c.merge_into == Some(a)) {
+                drop_channels(anim, clip);
+            } else if clips.iter().any(|c| {
+                c.merge_into.is_none()
+                    && anim.get("name").and_then(Value::as_str) == Some(c.name.as_str())
+            }) {
+                *anim = Value::Null;
+            }
+        }
     }
     for clip in clips {
         let n = clip.times.len();
@@ -407,10 +438,25 @@ pub fn export_glb(source: &ExportSource, clips: &[BakedClip]) -> Result<Vec<u8>,
             .unwrap()
             .entry("animations")
             .or_insert(json!([]));
-        anims
-            .as_array_mut()
-            .unwrap()
-            .push(json!({ "name": clip.name, "samplers": samplers, "channels": channels }));
+        let anims = anims.as_array_mut().unwrap();
+        match clip.merge_into {
+            Some(p) => {
+                let anim = &mut anims[p];
+                let base = anim["samplers"].as_array().map(|s| s.len()).unwrap_or(0);
+                for ch in &mut channels {
+                    let k = ch["sampler"].as_u64().unwrap_or(0) as usize;
+                    ch["sampler"] = json!(base + k);
+                }
+                append(anim, "samplers", samplers);
+                append(anim, "channels", channels);
+            }
+            None => anims.push(
+                json!({ "name": clip.name, "samplers": samplers, "channels": channels }),
+            ),
+        }
+    }
+    if let Some(anims) = out.json.get_mut("animations").and_then(Value::as_array_mut) {
+        anims.retain(|a| !a.is_null());
     }
     if out
         .json
@@ -422,6 +468,61 @@ pub fn export_glb(source: &ExportSource, clips: &[BakedClip]) -> Result<Vec<u8>,
         out.json.as_object_mut().unwrap().remove("animations");
     }
     write_glb(out)
+}
+
+/// Removes from `anim` the channels on the nodes and properties `clip` keys, and the
+/// samplers no other channel uses (the remaining channels are renumbered).
+fn drop_channels(anim: &mut Value, clip: &BakedClip) {
+    let keyed = |node: u64, path: &str| {
+        clip.tracks.iter().any(|t| {
+            t.node as u64 == node
+                && match path {
+                    "translation" => t.translations.is_some(),
+                    "rotation" => t.rotations.is_some(),
+                    "scale" => t.scales.is_some(),
+                    _ => false,
+                }
+        })
+    };
+    let Some(channels) = anim.get_mut("channels").and_then(Value::as_array_mut) else {
+        return;
+    };
+    channels.retain(|ch| {
+        let node = ch["target"].get("node").and_then(Value::as_u64);
+        let path = ch["target"].get("path").and_then(Value::as_str).unwrap_or("");
+        !matches!(node, Some(n) if keyed(n, path))
+    });
+    let used: Vec<u64> = channels
+        .iter()
+        .filter_map(|c| c.get("sampler").and_then(Value::as_u64))
+        .collect();
+    let Some(samplers) = anim.get_mut("samplers").and_then(Value::as_array_mut) else {
+        return;
+    };
+    let mut new_index = vec![None; samplers.len()];
+    let mut kept = Vec::new();
+    for (i, s) in samplers.drain(..).enumerate() {
+        if used.contains(&(i as u64)) {
+            new_index[i] = Some(kept.len());
+            kept.push(s);
+        }
+    }
+    *samplers = kept;
+    if let Some(channels) = anim.get_mut("channels").and_then(Value::as_array_mut) {
+        for ch in channels {
+            let old = ch["sampler"].as_u64().unwrap_or(0) as usize;
+            if let Some(Some(n)) = new_index.get(old) {
+                ch["sampler"] = json!(n);
+            }
+        }
+    }
+}
+
+fn append(obj: &mut Value, key: &str, items: Vec<Value>) {
+    match obj.get_mut(key).and_then(Value::as_array_mut) {
+        Some(a) => a.extend(items),
+        None => obj[key] = Value::Array(items),
+    }
 }
 
 fn write_glb(mut doc: ExportSource) -> Result<Vec<u8>, GltfError> {

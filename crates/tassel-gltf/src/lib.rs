@@ -4,14 +4,19 @@
 //!   inverse bind matrices, the rest pose and animation clips, and VRM spring bones
 //!   (`VRMC_springBone` 1.0 with extended colliders, VRM 0.x `secondaryAnimation`).
 //! - [`export_glb`]: a GLB with the skeleton (and, when there was an input file, its
-//!   meshes, skins, materials and textures) plus baked animations, one key per frame.
+//!   meshes, skins, materials and textures) plus baked animations, one key per frame;
+//!   baked keys can go into an input animation in place ([`BakedClip::merge_into`]).
+//! - [`bake_clip`]: play a clip through a [`tassel::CharacterSim`] and key the bones it
+//!   simulates.
 
+mod bake;
 mod error;
 mod export;
 mod import;
 mod mesh;
 mod vrm;
 
+pub use bake::{bake_clip, key_times, BakeOptions, BakeSource, Sway};
 pub use error::GltfError;
 pub use export::{export_glb, BakedClip, BakedTrack, BoneMesh, ExportSource};
 pub use import::{load, load_slice, Model, SkinInfo};

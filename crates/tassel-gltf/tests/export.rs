@@ -59,6 +59,7 @@ fn fox_with_a_simulated_tail_round_trips_and_validates() {
         name: clip.name.clone(),
         times,
         tracks,
+        merge_into: None,
     };
     let glb = export_glb(&model.source, &[baked]).unwrap();
 
@@ -140,6 +141,7 @@ fn bad_clips_are_rejected() {
             translations: Some(vec![glam::Vec3::ZERO; n]),
             ..Default::default()
         }],
+        merge_into: None,
     };
     assert!(
         export_glb(&src, &[clip(vec![0.0, 0.0], 2)]).is_err(),

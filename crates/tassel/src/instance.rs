@@ -268,6 +268,23 @@ impl CharacterSim {
         &self.vrm_state
     }
 
+    /// Every joint a solver writes (VRM springs, chain joints that turn or move, springs,
+    /// cloth and rope bones), sorted, each once: the joints a bake must key.
+    pub fn simulated_joints(&self) -> Vec<usize> {
+        let mut out: Vec<usize> = self.vrm.simulated_joints().collect();
+        out.extend(self.rig.rotating_joints().map(|(j, _, _)| j));
+        out.extend((0..self.rig.point_count()).filter_map(|p| {
+            let info = self.rig.point(p);
+            info.parent.and(info.joint)
+        }));
+        out.extend((0..self.springs.len()).map(|i| self.springs.joint(i)));
+        out.extend(self.cloths.simulated_joints());
+        out.extend(self.ropes.simulated_joints());
+        out.sort_unstable();
+        out.dedup();
+        out
+    }
+
     /// The last output pose.
     pub fn pose(&self) -> &Pose {
         &self.pose

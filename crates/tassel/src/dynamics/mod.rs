@@ -6,6 +6,7 @@
 pub mod chain;
 pub mod cloth;
 mod curve;
+mod mode;
 pub mod particles;
 mod rig;
 pub mod rope;
@@ -13,5 +14,6 @@ pub mod spring;
 pub mod vrm;
 
 pub use curve::Curve;
+pub use mode::SimMode;
 pub(crate) use rig::CompiledCollider;
 pub use rig::{ColliderSettings, RigSettings};

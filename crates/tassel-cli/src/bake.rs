@@ -1,0 +1,192 @@
+//! `tassel bake`: a model's clips with their secondary motion keyed in, written as GLB.
+
+use crate::output::{check_output_dir, write_atomic};
+use crate::progress::Progress;
+use crate::simulate::{read_rig, Mode};
+use std::path::PathBuf;
+use tassel::dynamics::{RigSettings, SimMode};
+use tassel::CharacterSim;
+use tassel_gltf::{bake_clip, export_glb, BakeOptions, BakeSource, Model, Sway};
+
+/// Options of `tassel bake`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// The model (.glb, .gltf, .vrm).
+    input: PathBuf,
+    /// Rig file (TOML) with chains, springs, cloths, ropes and colliders; optional for a
+    /// VRM (its spring bones run in any case).
+    #[arg(long)]
+    rig: Option<PathBuf>,
+    /// A clip to bake, by name (repeatable). Default: every clip.
+    #[arg(long, conflicts_with = "all_clips")]
+    clip: Vec<String>,
+    /// Bake every clip (the default).
+    #[arg(long)]
+    all_clips: bool,
+    /// Keys per second of the baked bones.
+    #[arg(long, default_value_t = 60.0)]
+    fps: f32,
+    /// spec: VRM springs by the specification (default for VRM); fixed: VRM springs and
+    /// chains at a fixed rate; classic: chains frame by frame. Default for a rig: what the
+    /// rig says.
+    #[arg(long, value_enum)]
+    mode: Option<Mode>,
+    /// Seconds each clip plays, looped, before its first key, so that the motion starts
+    /// settled.
+    #[arg(long, default_value_t = 1.0)]
+    warmup: f32,
+    /// For a file without clips: length of the `rest` clip baked instead (the rest pose
+    /// held while the secondary motion settles), seconds.
+    #[arg(long, default_value_t = 2.0)]
+    rest_duration: f32,
+    /// Move the whole character back and forth while baking: the largest offset as X,Y,Z
+    /// in the file's units (e.g. 0.1,0,0); the root nodes are keyed with the motion. Gives
+    /// the springs of a file without clips something to swing from.
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    sway: Option<glam::Vec3>,
+    /// Cycles per second of --sway.
+    #[arg(long, default_value_t = 1.0)]
+    sway_hz: f32,
+    /// Output file (GLB, also for a .vrm input).
+    #[arg(short, long)]
+    out: PathBuf,
+}
+
+pub fn run(a: Args) -> Result<(), String> {
+    check_output_dir(&a.out)?;
+    let options = BakeOptions {
+        fps: a.fps,
+        warmup: a.warmup,
+        rest_duration: a.rest_duration,
+        sway: a.sway.map(|amplitude| Sway {
+            amplitude,
+            frequency: a.sway_hz,
+        }),
+    };
+    options.validate().map_err(|e| e.to_string())?;
+    let model = tassel_gltf::load(&a.input).map_err(|e| e.to_string())?;
+    let sources = choose_clips(&model, &a)?;
+    let mut sim = build_sim(&model, a.rig.as_ref(), a.mode, &a.input)?;
+    let joints = sim.simulated_joints();
+    if joints.is_empty() {
+        return Err(format!(
+            "{}: nothing to bake: the rig and the file's VRM springs simulate no bone",
+            a.input.display()
+        ));
+    }
+    let mut baked = Vec::new();
+    let mut summary = Vec::new();
+    for source in sources {
+        let name = match source {
+            BakeSource::Clip(i) => model.clips[i].name.clone(),
+            BakeSource::Rest if a.sway.is_some() => "sway".to_string(),
+            BakeSource::Rest => "rest".to_string(),
+        };
+        let mut bar = Progress::new(&format!("baking '{name}'"));
+        let clip = bake_clip(&model, &mut sim, source, &options, &mut |d, t| {
+            bar.update(d, t)
+        })
+        .map_err(|e| e.to_string())?;
+        bar.finish();
+        summary.push(format!("'{}' {} keys", clip.name, clip.times.len()));
+        baked.push(clip);
+    }
+    let glb = export_glb(&model.source, &baked).map_err(|e| e.to_string())?;
+    write_atomic(&a.out, &glb)?;
+    say!(
+        "wrote {} ({} bytes): {} with {} simulated bone(s) ({})",
+        a.out.display(),
+        glb.len(),
+        summary.join(", "),
+        joints.len(),
+        joints
+            .iter()
+            .map(|&j| model.skeleton.name(j))
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    Ok(())
+}
+
+/// The clips named on the command line, or all; a file without clips gets the rest clip.
+fn choose_clips(model: &Model, a: &Args) -> Result<Vec<BakeSource>, String> {
+    if a.clip.is_empty() {
+        if model.clips.is_empty() {
+            return Ok(vec![BakeSource::Rest]);
+        }
+        return Ok((0..model.clips.len()).map(BakeSource::Clip).collect());
+    }
+    let mut out = Vec::new();
+    for name in &a.clip {
+        let i = model
+            .clips
+            .iter()
+            .position(|c| &c.name == name)
+            .ok_or_else(|| {
+                let names: Vec<String> =
+                    model.clips.iter().map(|c| format!("'{}'", c.name)).collect();
+                format!(
+                    "{}: no clip named '{name}'; the file has {}",
+                    a.input.display(),
+                    if names.is_empty() {
+                        "no clips".to_string()
+                    } else {
+                        names.join(", ")
+                    }
+                )
+            })?;
+        if !out.contains(&BakeSource::Clip(i)) {
+            out.push(BakeSource::Clip(i));
+        }
+    }
+    Ok(out)
+}
+
+/// The character's solvers: the file's VRM springs and the rig's chains, springs, cloths
+/// and ropes, stepped in `mode`.
+pub fn build_sim(
+    model: &Model,
+    rig_path: Option<&PathBuf>,
+    mode: Option<Mode>,
+    input: &std::path::Path,
+) -> Result<CharacterSim, String> {
+    let vrm = model
+        .vrm
+        .as_ref()
+        .map(|v| v.springs.clone())
+        .unwrap_or_default();
+    let mut rig = match rig_path {
+        Some(p) => read_rig(p)?,
+        None if !vrm.is_empty() => RigSettings::default(),
+        None => {
+            return Err(format!(
+                "{}: the file has no VRM spring bones; give --rig RIG.toml",
+                input.display()
+            ))
+        }
+    };
+    let (_, options) = SimMode::apply(mode.map(Mode::into), &mut rig, !vrm.is_empty())
+        .map_err(|e| format!("--mode: {e}"))?;
+    CharacterSim::with_vrm(model.skeleton.clone(), &rig, &vrm, options).map_err(|e| match rig_path
+    {
+        Some(p) => format!("{}: {e}", p.display()),
+        None => e.to_string(),
+    })
+}
+
+/// `X,Y,Z` as a vector.
+pub fn parse_vec3(text: &str) -> Result<glam::Vec3, String> {
+    let parts: Vec<&str> = text.split(',').map(str::trim).collect();
+    let bad = || format!("'{text}' is not X,Y,Z (three numbers separated by commas)");
+    if parts.len() != 3 {
+        return Err(bad());
+    }
+    let mut v = [0.0f32; 3];
+    for (i, p) in parts.iter().enumerate() {
+        v[i] = p.parse().map_err(|_| bad())?;
+        if !v[i].is_finite() {
+            return Err(bad());
+        }
+    }
+    Ok(glam::Vec3::from_array(v))
+}

@@ -1,0 +1,75 @@
+//! One switch for how a whole character steps: the `--mode` of `tassel simulate`,
+//! `bake`, `render` and `plot`.
+
+use super::chain::TimeMode;
+use super::vrm::{VrmMode, VrmOptions};
+use super::RigSettings;
+use crate::error::{Error, Result};
+
+/// How a character's secondary motion is stepped.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SimMode {
+    /// VRM springs exactly as the VRM specification steps them (once per frame, the look
+    /// depends on the frame rate); rig chains keep the mode the rig file gives them.
+    Spec,
+    /// VRM springs and chains at a fixed internal rate: the look does not depend on the
+    /// frame rate.
+    Fixed,
+    /// Chains frame by frame as KawaiiPhysics does (VRM springs by the specification): the
+    /// frame-rate-dependent pair, for comparison.
+    Classic,
+}
+
+impl SimMode {
+    /// `spec`, `fixed` or `classic`.
+    pub fn name(self) -> &'static str {
+        match self {
+            SimMode::Spec => "spec",
+            SimMode::Fixed => "fixed",
+            SimMode::Classic => "classic",
+        }
+    }
+
+    /// Settles the mode for a rig (and a model with or without VRM springs) and sets the
+    /// rig's chains to it. Without a requested mode: `spec` for a model with VRM springs,
+    /// else the first chain's own mode. `spec` without VRM springs is an error; `fixed` or
+    /// `classic` asked for explicitly set every chain's mode.
+    pub fn apply(
+        requested: Option<SimMode>,
+        rig: &mut RigSettings,
+        has_vrm: bool,
+    ) -> Result<(SimMode, VrmOptions)> {
+        let mode = match requested {
+            Some(m) => m,
+            None if has_vrm => SimMode::Spec,
+            None => match rig.chains.first().map(|c| c.mode) {
+                Some(TimeMode::Classic) => SimMode::Classic,
+                _ => SimMode::Fixed,
+            },
+        };
+        if mode == SimMode::Spec && !has_vrm {
+            return Err(Error::InvalidParameter(
+                "mode spec is the VRM spring-bone mode and this model has no VRM springs; use fixed or classic"
+                    .into(),
+            ));
+        }
+        if requested.is_some() && mode != SimMode::Spec {
+            for c in &mut rig.chains {
+                c.mode = if mode == SimMode::Classic {
+                    TimeMode::Classic
+                } else {
+                    TimeMode::Fixed
+                };
+            }
+        }
+        let options = VrmOptions {
+            mode: if mode == SimMode::Fixed {
+                VrmMode::Fixed
+            } else {
+                VrmMode::Spec
+            },
+            ..VrmOptions::default()
+        };
+        Ok((mode, options))
+    }
+}
