@@ -5,6 +5,7 @@ use crate::error::GltfError;
 use crate::export::{BakedClip, BakedTrack};
 use crate::import::Model;
 use glam::{Quat, Vec3};
+use tassel::anim::Clip;
 use tassel::{CharacterSim, Transform};
 
 /// How a clip is baked.
@@ -133,6 +134,57 @@ pub fn key_times(duration: f32, fps: f32) -> Vec<f32> {
     times
 }
 
+/// Plays `clip` (or the rest pose) through `sim`: resets it, runs the warm-up (the clip
+/// looped from `-warmup` seconds; the first frame, with dt = 0, places every solver on the
+/// animated pose), then one frame at each of `times` (the clip sampled exactly there, not
+/// wrapped), calling `on_frame(k, t, animated locals, character transform, sim)` after
+/// each. The character's transform is [`BakeOptions::component`]. Errors from `sim` and
+/// from `on_frame` stop the run.
+pub fn play(
+    sim: &mut CharacterSim,
+    clip: Option<&Clip>,
+    times: &[f32],
+    options: &BakeOptions,
+    on_frame: &mut dyn FnMut(usize, f32, &[Transform], &Transform, &CharacterSim) -> Result<(), String>,
+) -> Result<(), String> {
+    options.validate().map_err(|e| e.to_string())?;
+    let rest = sim.skeleton().rest().to_vec();
+    let mut locals = rest.clone();
+    let step = 1.0 / options.fps;
+    sim.reset();
+    let warm_frames = (options.warmup * options.fps).round() as u32;
+    let start = -(warm_frames as f32) * step;
+    let mut t_prev = start;
+    for k in 0..warm_frames {
+        let t = start + k as f32 * step;
+        locals.copy_from_slice(&rest);
+        if let Some(c) = clip {
+            c.sample_looped(t, &mut locals);
+        }
+        let dt = if k == 0 { 0.0 } else { t - t_prev };
+        sim.frame(&locals, options.component(t), dt)
+            .map_err(|e| e.to_string())?;
+        t_prev = t;
+    }
+    for (k, &t) in times.iter().enumerate() {
+        locals.copy_from_slice(&rest);
+        if let Some(c) = clip {
+            c.sample(t, &mut locals);
+        }
+        let dt = if warm_frames == 0 && k == 0 {
+            0.0
+        } else {
+            t - t_prev
+        };
+        let component = options.component(t);
+        sim.frame(&locals, component, dt)
+            .map_err(|e| e.to_string())?;
+        on_frame(k, t, &locals, &component, sim)?;
+        t_prev = t;
+    }
+    Ok(())
+}
+
 /// Bakes one clip of `model` with `sim` (built for `model.skeleton`; it is reset first).
 /// The result keys every joint `sim` simulates: rotations always, translations where a
 /// solver moved them; with [`BakedClip::merge_into`] set to the clip's animation, so
@@ -172,33 +224,8 @@ pub fn bake_clip(
             (None, name.to_string(), options.rest_duration, None)
         }
     };
-    let rest = model.skeleton.rest();
-    let mut locals = rest.to_vec();
-    let pose_at = |t: f32, locals: &mut Vec<Transform>| {
-        locals.copy_from_slice(rest);
-        if let Some(c) = clip {
-            c.sample_looped(t, locals);
-        }
-    };
-    let err = |e: tassel::Error| invalid(format!("clip '{name}': {e}"));
+    let err = |e: String| invalid(format!("clip '{name}': {e}"));
     let times = key_times(duration, options.fps);
-    let step = 1.0 / options.fps;
-    sim.reset();
-    // Warm-up: the clip looped from `-warmup` up to its start; the first frame (dt = 0)
-    // places every solver on the animated pose.
-    let warm_frames = (options.warmup * options.fps).round() as u32;
-    let start = -(warm_frames as f32) * step;
-    pose_at(start, &mut locals);
-    sim.frame(&locals, options.component(start), 0.0)
-        .map_err(err)?;
-    let mut t_prev = start;
-    for k in 1..warm_frames {
-        let t = start + k as f32 * step;
-        pose_at(t, &mut locals);
-        sim.frame(&locals, options.component(t), t - t_prev)
-            .map_err(err)?;
-        t_prev = t;
-    }
     let joints = sim.simulated_joints();
     // With a sway the roots carry the character's motion in the file.
     let roots: Vec<usize> = match options.sway {
@@ -207,41 +234,31 @@ pub fn bake_clip(
             .collect(),
         None => Vec::new(),
     };
-    let mut root_translations: Vec<Vec<Vec3>> = vec![Vec::with_capacity(times.len()); roots.len()];
     let mut rotations: Vec<Vec<Quat>> = vec![Vec::with_capacity(times.len()); joints.len()];
     let mut translations: Vec<Vec<Vec3>> = vec![Vec::with_capacity(times.len()); joints.len()];
     let mut moved = vec![false; joints.len()];
-    for (k, &t) in times.iter().enumerate() {
-        // Inside the clip the keys sample it exactly (the last key at its end, not wrapped).
-        locals.copy_from_slice(rest);
-        if let Some(c) = clip {
-            c.sample(t, &mut locals);
-        }
-        let dt = if warm_frames == 0 && k == 0 {
-            0.0
-        } else {
-            t - t_prev
-        };
-        let component = options.component(t);
-        let pose = sim.frame(&locals, component, dt).map_err(err)?;
+    let mut root_translations: Vec<Vec<Vec3>> = vec![Vec::with_capacity(times.len()); roots.len()];
+    play(sim, clip, &times, options, &mut |k, t, animated, component, sim| {
+        let pose = sim.pose();
         for (i, &j) in joints.iter().enumerate() {
             let l = pose.locals[j];
             if !l.translation.is_finite() || !l.rotation.is_finite() {
-                return Err(invalid(format!(
-                    "clip '{name}': joint '{}' is not finite at {t} s",
+                return Err(format!(
+                    "joint '{}' is not finite at {t} s",
                     model.skeleton.name(j)
-                )));
+                ));
             }
             rotations[i].push(l.rotation);
             translations[i].push(l.translation);
-            moved[i] |= l.translation != locals[j].translation;
+            moved[i] |= l.translation != animated[j].translation;
         }
         for (i, &r) in roots.iter().enumerate() {
             root_translations[i].push(component.translation + pose.locals[r].translation);
         }
-        t_prev = t;
         progress(k + 1, times.len());
-    }
+        Ok(())
+    })
+    .map_err(err)?;
     let mut tracks: Vec<BakedTrack> = joints
         .iter()
         .enumerate()
