@@ -2,9 +2,9 @@
 
 use crate::output::{check_output_dir, write_atomic};
 use crate::progress::Progress;
-use crate::simulate::{read_rig, Mode};
+use crate::simulate::Mode;
+use crate::subject::{make_sim, rig_or_vrm};
 use std::path::PathBuf;
-use tassel::dynamics::{RigSettings, SimMode};
 use tassel::CharacterSim;
 use tassel_gltf::{bake_clip, export_glb, BakeOptions, BakeSource, Model, Sway};
 
@@ -123,8 +123,11 @@ fn choose_clips(model: &Model, a: &Args) -> Result<Vec<BakeSource>, String> {
             .iter()
             .position(|c| &c.name == name)
             .ok_or_else(|| {
-                let names: Vec<String> =
-                    model.clips.iter().map(|c| format!("'{}'", c.name)).collect();
+                let names: Vec<String> = model
+                    .clips
+                    .iter()
+                    .map(|c| format!("'{}'", c.name))
+                    .collect();
                 format!(
                     "{}: no clip named '{name}'; the file has {}",
                     a.input.display(),
@@ -144,7 +147,7 @@ fn choose_clips(model: &Model, a: &Args) -> Result<Vec<BakeSource>, String> {
 
 /// The character's solvers: the file's VRM springs and the rig's chains, springs, cloths
 /// and ropes, stepped in `mode`.
-pub fn build_sim(
+fn build_sim(
     model: &Model,
     rig_path: Option<&PathBuf>,
     mode: Option<Mode>,
@@ -155,23 +158,12 @@ pub fn build_sim(
         .as_ref()
         .map(|v| v.springs.clone())
         .unwrap_or_default();
-    let mut rig = match rig_path {
-        Some(p) => read_rig(p)?,
-        None if !vrm.is_empty() => RigSettings::default(),
-        None => {
-            return Err(format!(
-                "{}: the file has no VRM spring bones; give --rig RIG.toml",
-                input.display()
-            ))
-        }
-    };
-    let (_, options) = SimMode::apply(mode.map(Mode::into), &mut rig, !vrm.is_empty())
-        .map_err(|e| format!("--mode: {e}"))?;
-    CharacterSim::with_vrm(model.skeleton.clone(), &rig, &vrm, options).map_err(|e| match rig_path
-    {
-        Some(p) => format!("{}: {e}", p.display()),
-        None => e.to_string(),
-    })
+    let rig = rig_or_vrm(rig_path, !vrm.is_empty(), input)?;
+    let (sim, _) = make_sim(&model.skeleton, &vrm, &rig, mode).map_err(|e| match rig_path {
+        Some(p) if e.starts_with("rig: ") => format!("{}: {}", p.display(), &e[5..]),
+        _ => e,
+    })?;
+    Ok(sim)
 }
 
 /// `X,Y,Z` as a vector.

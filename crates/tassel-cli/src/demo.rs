@@ -1,7 +1,6 @@
 //! `tassel demo`: the embedded character through the scripted sequence.
 
 use crate::output::write_atomic;
-use crate::picture::{draw, Panel, Series};
 use glam::{Quat, Vec3};
 use std::path::PathBuf;
 use std::time::Instant;
@@ -11,6 +10,7 @@ use tassel::collide::Shape;
 use tassel::dynamics::cloth::ConstraintKind;
 use tassel::CharacterSim;
 use tassel_gltf::{export_glb, BakedClip, BakedTrack, BoneMesh, ExportSource};
+use tassel_render::{draw_strip, Panel, Series};
 
 /// Options of `tassel demo`.
 #[derive(clap::Args)]
@@ -279,7 +279,7 @@ pub fn run(a: Args) -> Result<(), String> {
             values,
         })
         .collect();
-    let png = draw(&panels, &bands, &series, LevelRun::DURATION).png()?;
+    let png = draw_strip(&panels, &bands, &series, LevelRun::DURATION).png()?;
     let glb_path = a.out.join("demo.glb");
     let png_path = a.out.join("demo.png");
     write_atomic(&glb_path, &glb)?;

@@ -1,4 +1,5 @@
-//! The `tassel` command: `demo`, `simulate`, `sample`, `inspect`, `bake`, `bench`. Argument parsing, files and printing
+//! The `tassel` command: `demo`, `simulate`, `sample`, `inspect`, `bake`, `render`,
+//! `plot`, `bench`. Argument parsing, files and printing
 //! only; the work is in the `tassel` and `tassel-gltf` crates.
 
 /// `println!` that ignores a closed standard output (`tassel demo | head` must not panic
@@ -15,10 +16,12 @@ mod bench;
 mod demo;
 mod inspect;
 mod output;
-mod picture;
+mod plot;
 mod progress;
+mod render;
 mod sample;
 mod simulate;
+mod subject;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -49,6 +52,12 @@ enum Command {
     /// Bake secondary motion into a model's clips: play each clip, run the file's VRM
     /// springs and the rig's chains, springs and cloths, write a GLB with the clips keyed.
     Bake(bake::Args),
+    /// Pictures of a character's skeleton from the side and the front, simulated bones
+    /// highlighted and colliders drawn: a contact sheet (.png) or an animation (.gif).
+    Render(render::Args),
+    /// A PNG chart of a tip's displacement from the animated pose over time, comparing
+    /// modes and frame rates for the same motion.
+    Plot(plot::Args),
     /// Measure ns per joint-step for 16 chains × 8 joints with 8 colliders.
     Bench(bench::Args),
 }
@@ -60,6 +69,8 @@ fn main() -> ExitCode {
         Command::Simulate(a) => simulate::run(a),
         Command::Bench(a) => bench::run(a),
         Command::Bake(a) => bake::run(a),
+        Command::Render(a) => render::run(a),
+        Command::Plot(a) => plot::run(a),
         Command::Sample(a) => sample::run(a),
         Command::Inspect(a) => inspect::run(a),
     };

@@ -27,7 +27,10 @@ fn channels(json: &Value, bin: &[u8], a: usize) -> Channels {
         );
         let times = read_floats(json, bin, s["input"].as_u64().unwrap() as usize);
         let values = read_floats(json, bin, s["output"].as_u64().unwrap() as usize);
-        assert!(out.insert(key, (times, values)).is_none(), "two channels on one target");
+        assert!(
+            out.insert(key, (times, values)).is_none(),
+            "two channels on one target"
+        );
     }
     out
 }
@@ -35,7 +38,14 @@ fn channels(json: &Value, bin: &[u8], a: usize) -> Channels {
 /// The input's LINEAR rotation at `t` (normalised lerp in one hemisphere: within 0.1° of
 /// slerp for the few-degree steps between Fox keys).
 fn rotation_at(times: &[f32], values: &[f32], t: f32) -> [f32; 4] {
-    let q = |i: usize| [values[4 * i], values[4 * i + 1], values[4 * i + 2], values[4 * i + 3]];
+    let q = |i: usize| {
+        [
+            values[4 * i],
+            values[4 * i + 1],
+            values[4 * i + 2],
+            values[4 * i + 3],
+        ]
+    };
     let k = times.iter().position(|&x| x > t).unwrap_or(times.len());
     if k == 0 {
         return q(0);
@@ -74,7 +84,11 @@ fn bake_fox_keys_the_tail_and_keeps_everything_else() {
         .arg(&out)
         .output()
         .unwrap();
-    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
     // Not a terminal: no progress bar in the captured error stream.
     assert!(!String::from_utf8_lossy(&run.stderr).contains('#'));
     validate(&out);
@@ -93,7 +107,15 @@ fn bake_fox_keys_the_tail_and_keeps_everything_else() {
     assert_eq!(names(&oj), names(&ij));
     // Nodes, meshes, skins, materials, textures, images: the same JSON, and the mesh and
     // skin data the same bytes.
-    for key in ["nodes", "scenes", "meshes", "skins", "materials", "textures", "images"] {
+    for key in [
+        "nodes",
+        "scenes",
+        "meshes",
+        "skins",
+        "materials",
+        "textures",
+        "images",
+    ] {
         assert_eq!(oj.get(key), ij.get(key), "{key} changed");
     }
     let prim = &ij["meshes"][0]["primitives"][0];
@@ -139,7 +161,11 @@ fn bake_fox_keys_the_tail_and_keeps_everything_else() {
         // Every other channel: the same keys, bit for bit.
         for (key, chan) in &before {
             if !tail.contains(&key.0) {
-                assert_eq!(after.get(key), Some(chan), "clip {a} channel {key:?} changed");
+                assert_eq!(
+                    after.get(key),
+                    Some(chan),
+                    "clip {a} channel {key:?} changed"
+                );
             }
         }
         for key in after.keys() {
@@ -164,7 +190,12 @@ fn bake_fox_keys_the_tail_and_keeps_everything_else() {
                 .iter()
                 .enumerate()
                 .map(|(k, &t)| {
-                    let baked = [values[4 * k], values[4 * k + 1], values[4 * k + 2], values[4 * k + 3]];
+                    let baked = [
+                        values[4 * k],
+                        values[4 * k + 1],
+                        values[4 * k + 2],
+                        values[4 * k + 3],
+                    ];
                     angle_deg(baked, rotation_at(it, iv, t))
                 })
                 .fold(0.0, f32::max);
@@ -189,15 +220,29 @@ fn bake_vrm_keeps_its_extensions() {
     let run = tassel()
         .arg("bake")
         .arg(&vrm)
-        .args(["--mode", "fixed", "--warmup", "0", "--sway", "0.1,0,0", "-o"])
+        .args([
+            "--mode", "fixed", "--warmup", "0", "--sway", "0.1,0,0", "-o",
+        ])
         .arg(&out)
         .output()
         .unwrap();
-    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
     validate(&out);
     let (ij, _) = glb_chunks(&std::fs::read(&vrm).unwrap());
     let (oj, ob) = glb_chunks(&std::fs::read(&out).unwrap());
-    for key in ["extensions", "extensionsUsed", "extensionsRequired", "nodes", "meshes", "skins", "materials"] {
+    for key in [
+        "extensions",
+        "extensionsUsed",
+        "extensionsRequired",
+        "nodes",
+        "meshes",
+        "skins",
+        "materials",
+    ] {
         assert_eq!(oj.get(key), ij.get(key), "{key} changed");
     }
     assert!(oj["extensions"]["VRMC_springBone"].is_object());
@@ -216,7 +261,11 @@ fn bake_vrm_keeps_its_extensions() {
     let (rt, rv) = &chans_root[&(root, "translation".to_string())];
     for (k, &t) in rt.iter().enumerate() {
         let x = root_t[0] + 0.1 * (std::f32::consts::TAU * t).sin();
-        assert!((rv[3 * k] - x).abs() < 1e-5, "root x at {t}: {} vs {x}", rv[3 * k]);
+        assert!(
+            (rv[3 * k] - x).abs() < 1e-5,
+            "root x at {t}: {} vs {x}",
+            rv[3 * k]
+        );
         assert!((rv[3 * k + 1] - root_t[1]).abs() < 1e-6);
     }
     let springs: Vec<u64> = ij["extensions"]["VRMC_springBone"]["springs"][0]["joints"]
@@ -232,23 +281,45 @@ fn bake_vrm_keeps_its_extensions() {
         let rest = ij["nodes"][node as usize]
             .get("rotation")
             .map(|r| {
-                let v: Vec<f32> = r.as_array().unwrap().iter().map(|x| x.as_f64().unwrap() as f32).collect();
+                let v: Vec<f32> = r
+                    .as_array()
+                    .unwrap()
+                    .iter()
+                    .map(|x| x.as_f64().unwrap() as f32)
+                    .collect();
                 [v[0], v[1], v[2], v[3]]
             })
             .unwrap_or([0.0, 0.0, 0.0, 1.0]);
         let first = [values[0], values[1], values[2], values[3]];
         let n = times.len() - 1;
-        let last = [values[4 * n], values[4 * n + 1], values[4 * n + 2], values[4 * n + 3]];
-        assert!(angle_deg(first, rest) < 0.5, "node {node} does not start at rest");
+        let last = [
+            values[4 * n],
+            values[4 * n + 1],
+            values[4 * n + 2],
+            values[4 * n + 3],
+        ];
+        assert!(
+            angle_deg(first, rest) < 0.5,
+            "node {node} does not start at rest"
+        );
         assert!(angle_deg(last, rest) > 1.0, "node {node} never moved");
     }
 }
 
 fn assert_bake_fails(args: &[&std::ffi::OsStr], out: &Path, needle: &str) {
-    let run = tassel().arg("bake").args(args).arg("-o").arg(out).output().unwrap();
+    let run = tassel()
+        .arg("bake")
+        .args(args)
+        .arg("-o")
+        .arg(out)
+        .output()
+        .unwrap();
     let err = String::from_utf8_lossy(&run.stderr);
     assert!(!run.status.success(), "bake {args:?} succeeded");
-    assert!(err.contains(needle), "error {err:?} does not say {needle:?}");
+    assert!(
+        err.contains(needle),
+        "error {err:?} does not say {needle:?}"
+    );
     assert!(!out.exists(), "{} was written", out.display());
     if let Some(dir) = out.parent().filter(|d| d.is_dir()) {
         let left: Vec<_> = std::fs::read_dir(dir).unwrap().collect();
@@ -269,16 +340,30 @@ fn bake_bad_input_fails_cleanly() {
     let bytes = std::fs::read(&fox).unwrap();
     let cut = scratch.join("truncated.glb");
     std::fs::write(&cut, &bytes[..bytes.len() / 2]).unwrap();
-    assert_bake_fails(&[cut.as_os_str(), "--rig".as_ref(), rig.as_os_str()], &out, "truncated.glb");
+    assert_bake_fails(
+        &[cut.as_os_str(), "--rig".as_ref(), rig.as_os_str()],
+        &out,
+        "truncated.glb",
+    );
     // A clip that is not there: the message names it and lists the file's clips.
     assert_bake_fails(
-        &[fox.as_os_str(), "--rig".as_ref(), rig.as_os_str(), "--clip".as_ref(), "Gallop".as_ref()],
+        &[
+            fox.as_os_str(),
+            "--rig".as_ref(),
+            rig.as_os_str(),
+            "--clip".as_ref(),
+            "Gallop".as_ref(),
+        ],
         &out,
         "no clip named 'Gallop'; the file has 'Survey', 'Walk', 'Run'",
     );
     // An output folder that does not exist, and an output path that is a folder.
     let nowhere = dir.join("missing").join("out.glb");
-    assert_bake_fails(&[fox.as_os_str(), "--rig".as_ref(), rig.as_os_str()], &nowhere, "does not exist");
+    assert_bake_fails(
+        &[fox.as_os_str(), "--rig".as_ref(), rig.as_os_str()],
+        &nowhere,
+        "does not exist",
+    );
     let run = tassel()
         .arg("bake")
         .arg(&fox)
@@ -293,15 +378,31 @@ fn bake_bad_input_fails_cleanly() {
     // A rig naming a bone the fox does not have; no rig and no VRM springs; bad options.
     let bad_rig = scratch.join("bad.toml");
     std::fs::write(&bad_rig, "[[chain]]\nroot = \"b_Ear_L\"\n").unwrap();
-    assert_bake_fails(&[fox.as_os_str(), "--rig".as_ref(), bad_rig.as_os_str()], &out, "b_Ear_L");
+    assert_bake_fails(
+        &[fox.as_os_str(), "--rig".as_ref(), bad_rig.as_os_str()],
+        &out,
+        "b_Ear_L",
+    );
     assert_bake_fails(&[fox.as_os_str()], &out, "give --rig");
     assert_bake_fails(
-        &[fox.as_os_str(), "--rig".as_ref(), rig.as_os_str(), "--fps".as_ref(), "0".as_ref()],
+        &[
+            fox.as_os_str(),
+            "--rig".as_ref(),
+            rig.as_os_str(),
+            "--fps".as_ref(),
+            "0".as_ref(),
+        ],
         &out,
         "fps 0",
     );
     assert_bake_fails(
-        &[fox.as_os_str(), "--rig".as_ref(), rig.as_os_str(), "--mode".as_ref(), "spec".as_ref()],
+        &[
+            fox.as_os_str(),
+            "--rig".as_ref(),
+            rig.as_os_str(),
+            "--mode".as_ref(),
+            "spec".as_ref(),
+        ],
         &out,
         "no VRM springs",
     );

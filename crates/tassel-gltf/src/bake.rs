@@ -134,18 +134,31 @@ pub fn key_times(duration: f32, fps: f32) -> Vec<f32> {
     times
 }
 
+/// One frame of [`play`], after the solvers ran.
+pub struct PlayedFrame<'a> {
+    /// Index into the times.
+    pub index: usize,
+    /// Seconds into the clip.
+    pub time: f32,
+    /// The animated local pose the solvers started from.
+    pub animated: &'a [Transform],
+    /// The character's transform.
+    pub component: Transform,
+    /// The simulation, its pose and states as of this frame.
+    pub sim: &'a CharacterSim,
+}
+
 /// Plays `clip` (or the rest pose) through `sim`: resets it, runs the warm-up (the clip
 /// looped from `-warmup` seconds; the first frame, with dt = 0, places every solver on the
 /// animated pose), then one frame at each of `times` (the clip sampled exactly there, not
-/// wrapped), calling `on_frame(k, t, animated locals, character transform, sim)` after
-/// each. The character's transform is [`BakeOptions::component`]. Errors from `sim` and
-/// from `on_frame` stop the run.
+/// wrapped), calling `on_frame` after each. The character's transform is
+/// [`BakeOptions::component`]. Errors from `sim` and from `on_frame` stop the run.
 pub fn play(
     sim: &mut CharacterSim,
     clip: Option<&Clip>,
     times: &[f32],
     options: &BakeOptions,
-    on_frame: &mut dyn FnMut(usize, f32, &[Transform], &Transform, &CharacterSim) -> Result<(), String>,
+    on_frame: &mut dyn FnMut(&PlayedFrame) -> Result<(), String>,
 ) -> Result<(), String> {
     options.validate().map_err(|e| e.to_string())?;
     let rest = sim.skeleton().rest().to_vec();
@@ -179,7 +192,13 @@ pub fn play(
         let component = options.component(t);
         sim.frame(&locals, component, dt)
             .map_err(|e| e.to_string())?;
-        on_frame(k, t, &locals, &component, sim)?;
+        on_frame(&PlayedFrame {
+            index: k,
+            time: t,
+            animated: &locals,
+            component,
+            sim,
+        })?;
         t_prev = t;
     }
     Ok(())
@@ -220,7 +239,11 @@ pub fn bake_clip(
             (Some(clip), clip.name.clone(), clip.duration, Some(i))
         }
         BakeSource::Rest => {
-            let name = if options.sway.is_some() { "sway" } else { "rest" };
+            let name = if options.sway.is_some() {
+                "sway"
+            } else {
+                "rest"
+            };
             (None, name.to_string(), options.rest_duration, None)
         }
     };
@@ -238,8 +261,9 @@ pub fn bake_clip(
     let mut translations: Vec<Vec<Vec3>> = vec![Vec::with_capacity(times.len()); joints.len()];
     let mut moved = vec![false; joints.len()];
     let mut root_translations: Vec<Vec<Vec3>> = vec![Vec::with_capacity(times.len()); roots.len()];
-    play(sim, clip, &times, options, &mut |k, t, animated, component, sim| {
-        let pose = sim.pose();
+    play(sim, clip, &times, options, &mut |f| {
+        let (k, t, animated, component) = (f.index, f.time, f.animated, f.component);
+        let pose = f.sim.pose();
         for (i, &j) in joints.iter().enumerate() {
             let l = pose.locals[j];
             if !l.translation.is_finite() || !l.rotation.is_finite() {

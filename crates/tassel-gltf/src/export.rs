@@ -450,9 +450,9 @@ pub fn export_glb(source: &ExportSource, clips: &[BakedClip]) -> Result<Vec<u8>,
                 append(anim, "samplers", samplers);
                 append(anim, "channels", channels);
             }
-            None => anims.push(
-                json!({ "name": clip.name, "samplers": samplers, "channels": channels }),
-            ),
+            None => {
+                anims.push(json!({ "name": clip.name, "samplers": samplers, "channels": channels }))
+            }
         }
     }
     if let Some(anims) = out.json.get_mut("animations").and_then(Value::as_array_mut) {
@@ -489,7 +489,10 @@ fn drop_channels(anim: &mut Value, clip: &BakedClip) {
     };
     channels.retain(|ch| {
         let node = ch["target"].get("node").and_then(Value::as_u64);
-        let path = ch["target"].get("path").and_then(Value::as_str).unwrap_or("");
+        let path = ch["target"]
+            .get("path")
+            .and_then(Value::as_str)
+            .unwrap_or("");
         !matches!(node, Some(n) if keyed(n, path))
     });
     let used: Vec<u64> = channels

@@ -16,7 +16,7 @@ mod import;
 mod mesh;
 mod vrm;
 
-pub use bake::{bake_clip, key_times, play, BakeOptions, BakeSource, Sway};
+pub use bake::{bake_clip, key_times, play, BakeOptions, BakeSource, PlayedFrame, Sway};
 pub use error::GltfError;
 pub use export::{export_glb, BakedClip, BakedTrack, BoneMesh, ExportSource};
 pub use import::{load, load_slice, Model, SkinInfo};

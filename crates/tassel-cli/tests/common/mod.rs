@@ -54,7 +54,6 @@ pub fn validate(file: &Path) -> Option<String> {
     Some(text)
 }
 
-
 /// The JSON and BIN chunks of a GLB file, read by hand from the container layout
 /// (glTF 2.0 §4.4), independent of the loaders under test.
 pub fn glb_chunks(bytes: &[u8]) -> (serde_json::Value, Vec<u8>) {

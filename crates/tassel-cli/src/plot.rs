@@ -1,0 +1,171 @@
+//! `tassel plot`: how far a tip strays from its animated position over time, one line per
+//! mode and frame rate, for the same motion.
+
+use crate::bake::parse_vec3;
+use crate::output::{check_output_dir, write_atomic};
+use crate::simulate::Mode;
+use std::path::PathBuf;
+use tassel_gltf::{key_times, play, BakeOptions, Sway};
+use tassel_render::{Chart, ChartSeries, PALETTE};
+
+/// Options of `tassel plot`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// The model (.glb, .gltf, .vrm); omit with --builtin.
+    file: Option<PathBuf>,
+    /// Use the embedded character (its own rig unless --rig is given).
+    #[arg(long)]
+    builtin: bool,
+    /// The clip to play. Default: the first; a file without clips holds its rest pose.
+    #[arg(long)]
+    clip: Option<String>,
+    /// Rig file (TOML); optional for a VRM.
+    #[arg(long)]
+    rig: Option<PathBuf>,
+    /// The joint whose displacement is plotted. Default: the deepest simulated joint.
+    #[arg(long)]
+    joint: Option<String>,
+    /// Modes to compare, comma-separated. Default: fixed,classic (spec,fixed for a model
+    /// whose only springs are VRM springs).
+    #[arg(long, value_delimiter = ',', value_enum)]
+    modes: Vec<Mode>,
+    /// Frame rates to compare, comma-separated, Hz.
+    #[arg(long, value_delimiter = ',', default_value = "60")]
+    rates: Vec<f32>,
+    /// Seconds the clip plays, looped, before the plot starts (the same for every line).
+    #[arg(long, default_value_t = 0.0)]
+    warmup: f32,
+    /// Move the whole character back and forth: largest offset X,Y,Z.
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    sway: Option<glam::Vec3>,
+    /// Cycles per second of --sway.
+    #[arg(long, default_value_t = 1.0)]
+    sway_hz: f32,
+    /// Seconds plotted (default: the clip's length, or 3 s for the rest pose).
+    #[arg(long)]
+    duration: Option<f32>,
+    /// Output PNG.
+    #[arg(short, long)]
+    out: PathBuf,
+}
+
+pub fn run(a: Args) -> Result<(), String> {
+    if a.out.extension().map(|e| e.to_ascii_lowercase()) != Some("png".into()) {
+        return Err(format!("{}: the chart is written as .png", a.out.display()));
+    }
+    check_output_dir(&a.out)?;
+    for &r in &a.rates {
+        if !(r.is_finite() && (1.0..=1000.0).contains(&r)) {
+            return Err(format!("--rates: {r} must be a frame rate in 1..=1000 Hz"));
+        }
+    }
+    let subject = crate::subject::load(a.file.as_ref(), a.builtin, a.rig.as_ref())?;
+    let clip = subject.clip(a.clip.as_deref())?;
+    let modes = if !a.modes.is_empty() {
+        a.modes.clone()
+    } else if !subject.vrm.is_empty() && subject.rig.chains.is_empty() {
+        vec![Mode::Spec, Mode::Fixed]
+    } else {
+        vec![Mode::Fixed, Mode::Classic]
+    };
+    let duration = match a.duration {
+        Some(d) if d.is_finite() && d > 0.0 && d <= 600.0 => d,
+        Some(d) => return Err(format!("--duration {d} must be in (0, 600] seconds")),
+        None => clip.map(|c| c.duration).filter(|d| *d > 0.0).unwrap_or(3.0),
+    };
+    // The joint: named, or the deepest one a solver moves.
+    let (probe, _) = subject.sim(Some(modes[0]))?;
+    let simulated = probe.simulated_joints();
+    let sk = &subject.skeleton;
+    let joint = match &a.joint {
+        Some(name) => sk
+            .find(name)
+            .ok_or_else(|| format!("--joint: the skeleton has no joint named '{name}'"))?,
+        None => {
+            // Prefer the tips of chains and VRM springs (what the modes change), then any
+            // simulated joint.
+            let chains = probe.chains();
+            let mut tips: Vec<usize> = (0..chains.point_count())
+                .filter_map(|p| {
+                    let info = chains.point(p);
+                    info.parent.and(info.joint)
+                })
+                .chain(probe.vrm().simulated_joints())
+                .collect();
+            if tips.is_empty() {
+                tips = simulated.clone();
+            }
+            *tips
+                .iter()
+                .max_by_key(|&&j| (depth(sk, j), std::cmp::Reverse(j)))
+                .ok_or("nothing to plot: the rig and the file's VRM springs simulate no bone")?
+        }
+    };
+    let mut series = Vec::new();
+    for (mi, &mode) in modes.iter().enumerate() {
+        for (ri, &rate) in a.rates.iter().enumerate() {
+            let (mut sim, m) = subject.sim(Some(mode))?;
+            let options = BakeOptions {
+                fps: rate,
+                warmup: a.warmup,
+                rest_duration: duration,
+                sway: a.sway.map(|amplitude| Sway {
+                    amplitude,
+                    frequency: a.sway_hz,
+                }),
+            };
+            let times = key_times(duration, rate);
+            let mut points = Vec::with_capacity(times.len());
+            play(&mut sim, clip, &times, &options, &mut |f| {
+                let c = &f.component;
+                let out = c.transform_point(f.sim.pose().models[joint].translation);
+                let anim = c.transform_point(f.sim.animated_models()[joint].translation);
+                points.push((f.time, (out - anim).length()));
+                Ok(())
+            })?;
+            series.push(ChartSeries {
+                name: format!("{} {} HZ", m.name(), rate),
+                color: PALETTE[(mi * a.rates.len() + ri) % PALETTE.len()],
+                points,
+            });
+        }
+    }
+    let units = if a.builtin { "M" } else { "FILE UNITS" };
+    let chart = Chart {
+        title: format!(
+            "{} - {} - {}",
+            subject.name,
+            clip.map(|c| c.name.as_str()).unwrap_or("REST"),
+            sk.name(joint)
+        ),
+        x_label: "TIME (S)".into(),
+        y_label: format!("TIP DISPLACEMENT FROM THE ANIMATION ({units})"),
+        series,
+    };
+    let png = chart.draw(900, 480).png()?;
+    write_atomic(&a.out, &png)?;
+    let largest: Vec<String> = chart
+        .series
+        .iter()
+        .map(|s| {
+            let m = s.points.iter().map(|p| p.1).fold(0.0f32, f32::max);
+            format!("{} max {m:.4}", s.name.to_lowercase())
+        })
+        .collect();
+    say!(
+        "wrote {} (joint '{}': {})",
+        a.out.display(),
+        sk.name(joint),
+        largest.join(", ")
+    );
+    Ok(())
+}
+
+fn depth(sk: &tassel::Skeleton, mut j: usize) -> usize {
+    let mut d = 0;
+    while let Some(p) = sk.parent(j) {
+        d += 1;
+        j = p;
+    }
+    d
+}

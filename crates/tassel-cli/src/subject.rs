@@ -1,0 +1,122 @@
+//! The character a command works on: a file (its skeleton, clips and VRM springs) or the
+//! embedded one, with the rig that drives its secondary motion.
+
+use crate::simulate::{read_rig, Mode};
+use std::path::{Path, PathBuf};
+use tassel::anim::Clip;
+use tassel::dynamics::vrm::VrmSpringBones;
+use tassel::dynamics::{RigSettings, SimMode};
+use tassel::{builtin, CharacterSim, Skeleton};
+
+pub struct Subject {
+    /// For titles and messages.
+    pub name: String,
+    pub skeleton: Skeleton,
+    pub clips: Vec<Clip>,
+    pub vrm: VrmSpringBones,
+    pub rig: RigSettings,
+}
+
+/// `FILE` or `--builtin`, with `--rig` (required for a file without VRM springs; replaces
+/// the embedded character's own rig).
+pub fn load(
+    file: Option<&PathBuf>,
+    builtin: bool,
+    rig: Option<&PathBuf>,
+) -> Result<Subject, String> {
+    match (file, builtin) {
+        (Some(_), true) => Err("give either FILE or --builtin, not both".into()),
+        (None, false) => Err("give a FILE or --builtin".into()),
+        (None, true) => {
+            let c = builtin::character();
+            Ok(Subject {
+                name: "BUILTIN".into(),
+                skeleton: c.skeleton,
+                clips: c.clips,
+                vrm: VrmSpringBones::default(),
+                rig: match rig {
+                    Some(p) => read_rig(p)?,
+                    None => c.rig,
+                },
+            })
+        }
+        (Some(path), false) => {
+            let model = tassel_gltf::load(path).map_err(|e| e.to_string())?;
+            let vrm = model.vrm.map(|v| v.springs).unwrap_or_default();
+            let rig = rig_or_vrm(rig, !vrm.is_empty(), path)?;
+            Ok(Subject {
+                name: path
+                    .file_name()
+                    .map(|n| n.to_string_lossy().to_string())
+                    .unwrap_or_default(),
+                skeleton: model.skeleton,
+                clips: model.clips,
+                vrm,
+                rig,
+            })
+        }
+    }
+}
+
+/// The rig file, or an empty rig for a model whose VRM springs are enough.
+pub fn rig_or_vrm(
+    rig: Option<&PathBuf>,
+    has_vrm: bool,
+    input: &Path,
+) -> Result<RigSettings, String> {
+    match rig {
+        Some(p) => read_rig(p),
+        None if has_vrm => Ok(RigSettings::default()),
+        None => Err(format!(
+            "{}: the file has no VRM spring bones; give --rig RIG.toml",
+            input.display()
+        )),
+    }
+}
+
+/// The solvers for `skeleton`: the VRM springs and the rig, stepped in `mode`.
+pub fn make_sim(
+    skeleton: &Skeleton,
+    vrm: &VrmSpringBones,
+    rig: &RigSettings,
+    mode: Option<Mode>,
+) -> Result<(CharacterSim, SimMode), String> {
+    let mut rig = rig.clone();
+    let (mode, options) = SimMode::apply(mode.map(Mode::into), &mut rig, !vrm.is_empty())
+        .map_err(|e| format!("--mode: {e}"))?;
+    let sim = CharacterSim::with_vrm(skeleton.clone(), &rig, vrm, options)
+        .map_err(|e| format!("rig: {e}"))?;
+    Ok((sim, mode))
+}
+
+impl Subject {
+    pub fn sim(&self, mode: Option<Mode>) -> Result<(CharacterSim, SimMode), String> {
+        make_sim(&self.skeleton, &self.vrm, &self.rig, mode)
+    }
+
+    /// The named clip, the first clip without a name, `None` (the rest pose) for a file
+    /// without clips.
+    pub fn clip(&self, name: Option<&str>) -> Result<Option<&Clip>, String> {
+        match name {
+            Some(n) => self
+                .clips
+                .iter()
+                .find(|c| c.name == n)
+                .map(Some)
+                .ok_or_else(|| {
+                    let names: Vec<String> =
+                        self.clips.iter().map(|c| format!("'{}'", c.name)).collect();
+                    format!(
+                        "{}: no clip named '{n}'; the file has {}",
+                        self.name,
+                        if names.is_empty() {
+                            "no clips".to_string()
+                        } else {
+                            names.join(", ")
+                        }
+                    )
+                }),
+            None => Ok(self.clips.first()),
+        }
+    }
+}

@@ -1,0 +1,179 @@
+//! What one moment of a character looks like as lines: its bones (simulated ones marked),
+//! virtual chain tips, and the colliders the solvers used, in world space.
+
+use glam::Vec3;
+use tassel::collide::{PlacedCollider, Shape};
+use tassel::dynamics::vrm::PlacedVrmCollider;
+use tassel::{CharacterSim, Transform};
+
+/// A collider's outline.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Outline {
+    /// A sphere.
+    Sphere {
+        /// Centre.
+        center: Vec3,
+        /// Radius.
+        radius: f32,
+    },
+    /// A capsule between two cap centres.
+    Capsule {
+        /// One end.
+        a: Vec3,
+        /// The other end.
+        b: Vec3,
+        /// Radius.
+        radius: f32,
+    },
+    /// An oriented box: its eight corners.
+    Box {
+        /// Corners, index bits (x, y, z) = (1, 2, 4) set for the + side.
+        corners: [Vec3; 8],
+    },
+    /// A plane through `point` with `normal` (drawn as a short stretch of its trace).
+    Plane {
+        /// A point of the plane.
+        point: Vec3,
+        /// Unit normal.
+        normal: Vec3,
+    },
+}
+
+impl Outline {
+    /// Points that bound the outline (for framing).
+    pub fn extent(&self) -> Vec<(Vec3, f32)> {
+        match *self {
+            Outline::Sphere { center, radius } => vec![(center, radius)],
+            Outline::Capsule { a, b, radius } => vec![(a, radius), (b, radius)],
+            Outline::Box { corners } => corners.iter().map(|c| (*c, 0.0)).collect(),
+            Outline::Plane { point, .. } => vec![(point, 0.0)],
+        }
+    }
+}
+
+/// A bone drawn from `from` to `to`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Bone {
+    /// Parent joint position.
+    pub from: Vec3,
+    /// Child joint position (or a virtual tip).
+    pub to: Vec3,
+    /// The child is moved by a solver (drawn highlighted).
+    pub simulated: bool,
+}
+
+/// One moment of a character, world space.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Figure {
+    /// Bones.
+    pub bones: Vec<Bone>,
+    /// Colliders.
+    pub colliders: Vec<Outline>,
+    /// Seconds into the clip (for labels).
+    pub time: f32,
+}
+
+impl Figure {
+    /// The last frame of `sim` under the character transform `component`: every bone
+    /// whose parent is a joint, chain tips without a joint, and the colliders of the VRM
+    /// springs, the chains (or, without chains, the cloths).
+    pub fn from_sim(sim: &CharacterSim, component: &Transform, time: f32) -> Figure {
+        let sk = sim.skeleton();
+        let models = &sim.pose().models;
+        let simulated = sim.simulated_joints();
+        let world = |p: Vec3| component.transform_point(p);
+        let mut bones = Vec::new();
+        for j in 0..sk.len() {
+            if let Some(p) = sk.parent(j) {
+                bones.push(Bone {
+                    from: world(models[p].translation),
+                    to: world(models[j].translation),
+                    simulated: simulated.binary_search(&j).is_ok(),
+                });
+            }
+        }
+        let chains = sim.chains();
+        let out = sim.state().output_positions();
+        for p in 0..chains.point_count() {
+            let info = chains.point(p);
+            if let (None, Some(parent)) = (info.joint, info.parent) {
+                if let (Some(a), Some(b)) = (out.get(parent), out.get(p)) {
+                    bones.push(Bone {
+                        from: world(*a),
+                        to: world(*b),
+                        simulated: true,
+                    });
+                }
+            }
+        }
+        let mut colliders: Vec<Outline> = sim
+            .vrm_state()
+            .placed_colliders()
+            .iter()
+            .map(|c| match *c {
+                PlacedVrmCollider::Sphere { center, radius, .. } => {
+                    Outline::Sphere { center, radius }
+                }
+                PlacedVrmCollider::Capsule {
+                    head, tail, radius, ..
+                } => Outline::Capsule {
+                    a: head,
+                    b: tail,
+                    radius,
+                },
+                PlacedVrmCollider::Plane { point, normal } => Outline::Plane { point, normal },
+            })
+            .collect();
+        if chains.point_count() > 0 {
+            for c in sim.state().placed_colliders() {
+                let placed = PlacedCollider {
+                    shape: c.shape,
+                    transform: *component * c.transform,
+                };
+                colliders.push(outline(&placed));
+            }
+        } else {
+            colliders.extend(sim.cloth_state().placed_colliders().iter().map(outline));
+        }
+        Figure {
+            bones,
+            colliders,
+            time,
+        }
+    }
+}
+
+/// The outline of a rig collider placed in world space.
+pub fn outline(c: &PlacedCollider) -> Outline {
+    let t = &c.transform;
+    match c.shape {
+        Shape::Sphere { radius, .. } => Outline::Sphere {
+            center: t.translation,
+            radius,
+        },
+        Shape::Capsule { radius, length } => {
+            let axis = t.rotation * Vec3::Y * (0.5 * length);
+            Outline::Capsule {
+                a: t.translation - axis,
+                b: t.translation + axis,
+                radius,
+            }
+        }
+        Shape::Box { half_extents } => {
+            let mut corners = [Vec3::ZERO; 8];
+            for (i, c) in corners.iter_mut().enumerate() {
+                let s = Vec3::new(
+                    if i & 1 != 0 { 1.0 } else { -1.0 },
+                    if i & 2 != 0 { 1.0 } else { -1.0 },
+                    if i & 4 != 0 { 1.0 } else { -1.0 },
+                );
+                *c = t.translation + t.rotation * (s * half_extents);
+            }
+            Outline::Box { corners }
+        }
+        Shape::Plane => Outline::Plane {
+            point: t.translation,
+            normal: t.rotation * Vec3::Y,
+        },
+    }
+}
