@@ -3,10 +3,10 @@
 use crate::output::{check_output_dir, write_atomic};
 use crate::progress::Progress;
 use crate::simulate::Mode;
-use crate::subject::{make_sim, rig_or_vrm};
+use crate::subject::{make_sim, rig_or_vrm, SwayArgs};
 use std::path::PathBuf;
 use tassel::CharacterSim;
-use tassel_gltf::{bake_clip, export_glb, BakeOptions, BakeSource, Model, Sway};
+use tassel_gltf::{bake_clip, export_glb, BakeOptions, BakeSource, Model};
 
 /// Options of `tassel bake`.
 #[derive(clap::Args)]
@@ -39,14 +39,8 @@ pub struct Args {
     /// held while the secondary motion settles), seconds.
     #[arg(long, default_value_t = 2.0)]
     rest_duration: f32,
-    /// Move the whole character back and forth while baking: the largest offset as X,Y,Z
-    /// in the file's units (e.g. 0.1,0,0); the root nodes are keyed with the motion. Gives
-    /// the springs of a file without clips something to swing from.
-    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
-    sway: Option<glam::Vec3>,
-    /// Cycles per second of --sway.
-    #[arg(long, default_value_t = 1.0)]
-    sway_hz: f32,
+    #[command(flatten)]
+    sway: SwayArgs,
     /// Output file (GLB, also for a .vrm input).
     #[arg(short, long)]
     out: PathBuf,
@@ -58,10 +52,7 @@ pub fn run(a: Args) -> Result<(), String> {
         fps: a.fps,
         warmup: a.warmup,
         rest_duration: a.rest_duration,
-        sway: a.sway.map(|amplitude| Sway {
-            amplitude,
-            frequency: a.sway_hz,
-        }),
+        sway: a.sway.sway(),
     };
     options.validate().map_err(|e| e.to_string())?;
     let model = tassel_gltf::load(&a.input).map_err(|e| e.to_string())?;
@@ -79,7 +70,7 @@ pub fn run(a: Args) -> Result<(), String> {
     for source in sources {
         let name = match source {
             BakeSource::Clip(i) => model.clips[i].name.clone(),
-            BakeSource::Rest if a.sway.is_some() => "sway".to_string(),
+            BakeSource::Rest if a.sway.sway().is_some() => "sway".to_string(),
             BakeSource::Rest => "rest".to_string(),
         };
         let mut bar = Progress::new(&format!("baking '{name}'"));
@@ -164,21 +155,4 @@ fn build_sim(
         _ => e,
     })?;
     Ok(sim)
-}
-
-/// `X,Y,Z` as a vector.
-pub fn parse_vec3(text: &str) -> Result<glam::Vec3, String> {
-    let parts: Vec<&str> = text.split(',').map(str::trim).collect();
-    let bad = || format!("'{text}' is not X,Y,Z (three numbers separated by commas)");
-    if parts.len() != 3 {
-        return Err(bad());
-    }
-    let mut v = [0.0f32; 3];
-    for (i, p) in parts.iter().enumerate() {
-        v[i] = p.parse().map_err(|_| bad())?;
-        if !v[i].is_finite() {
-            return Err(bad());
-        }
-    }
-    Ok(glam::Vec3::from_array(v))
 }

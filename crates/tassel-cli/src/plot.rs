@@ -1,27 +1,18 @@
 //! `tassel plot`: how far a tip strays from its animated position over time, one line per
 //! mode and frame rate, for the same motion.
 
-use crate::bake::parse_vec3;
 use crate::output::{check_output_dir, write_atomic};
 use crate::simulate::Mode;
+use crate::subject::{SubjectArgs, SwayArgs};
 use std::path::PathBuf;
-use tassel_gltf::{key_times, play, BakeOptions, Sway};
+use tassel_gltf::{key_times, play, BakeOptions};
 use tassel_render::{Chart, ChartSeries, PALETTE};
 
 /// Options of `tassel plot`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// The model (.glb, .gltf, .vrm); omit with --builtin.
-    file: Option<PathBuf>,
-    /// Use the embedded character (its own rig unless --rig is given).
-    #[arg(long)]
-    builtin: bool,
-    /// The clip to play. Default: the first; a file without clips holds its rest pose.
-    #[arg(long)]
-    clip: Option<String>,
-    /// Rig file (TOML); optional for a VRM.
-    #[arg(long)]
-    rig: Option<PathBuf>,
+    #[command(flatten)]
+    subject: SubjectArgs,
     /// The joint whose displacement is plotted. Default: the deepest simulated joint.
     #[arg(long)]
     joint: Option<String>,
@@ -35,12 +26,8 @@ pub struct Args {
     /// Seconds the clip plays, looped, before the plot starts (the same for every line).
     #[arg(long, default_value_t = 0.0)]
     warmup: f32,
-    /// Move the whole character back and forth: largest offset X,Y,Z.
-    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
-    sway: Option<glam::Vec3>,
-    /// Cycles per second of --sway.
-    #[arg(long, default_value_t = 1.0)]
-    sway_hz: f32,
+    #[command(flatten)]
+    sway: SwayArgs,
     /// Seconds plotted (default: the clip's length, or 3 s for the rest pose).
     #[arg(long)]
     duration: Option<f32>,
@@ -59,8 +46,8 @@ pub fn run(a: Args) -> Result<(), String> {
             return Err(format!("--rates: {r} must be a frame rate in 1..=1000 Hz"));
         }
     }
-    let subject = crate::subject::load(a.file.as_ref(), a.builtin, a.rig.as_ref())?;
-    let clip = subject.clip(a.clip.as_deref())?;
+    let (subject, clip) = a.subject.load()?;
+    let clip = clip.map(|i| &subject.clips[i]);
     let modes = if !a.modes.is_empty() {
         a.modes.clone()
     } else if !subject.vrm.is_empty() && subject.rig.chains.is_empty() {
@@ -109,10 +96,7 @@ pub fn run(a: Args) -> Result<(), String> {
                 fps: rate,
                 warmup: a.warmup,
                 rest_duration: duration,
-                sway: a.sway.map(|amplitude| Sway {
-                    amplitude,
-                    frequency: a.sway_hz,
-                }),
+                sway: a.sway.sway(),
             };
             let times = key_times(duration, rate);
             let mut points = Vec::with_capacity(times.len());
@@ -130,7 +114,7 @@ pub fn run(a: Args) -> Result<(), String> {
             });
         }
     }
-    let units = if a.builtin { "M" } else { "FILE UNITS" };
+    let units = if a.subject.builtin { "M" } else { "FILE UNITS" };
     let chart = Chart {
         title: format!(
             "{} - {} - {}",

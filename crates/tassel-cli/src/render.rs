@@ -1,39 +1,26 @@
 //! `tassel render`: the skeleton seen from the side and the front while a clip plays,
 //! as a contact sheet (.png) or an animation (.gif).
 
-use crate::bake::parse_vec3;
 use crate::output::{check_output_dir, write_atomic};
 use crate::simulate::Mode;
+use crate::subject::{SubjectArgs, SwayArgs};
 use std::path::PathBuf;
-use tassel_gltf::{key_times, play, BakeOptions, Sway};
+use tassel_gltf::{key_times, play, BakeOptions};
 use tassel_render::{animation_frames, contact_sheet, encode_gif, Figure};
 
 /// Options of `tassel render`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// The model (.glb, .gltf, .vrm); omit with --builtin.
-    file: Option<PathBuf>,
-    /// Use the embedded character (its own rig unless --rig is given).
-    #[arg(long)]
-    builtin: bool,
-    /// The clip to play. Default: the first; a file without clips holds its rest pose.
-    #[arg(long)]
-    clip: Option<String>,
-    /// Rig file (TOML); optional for a VRM.
-    #[arg(long)]
-    rig: Option<PathBuf>,
+    #[command(flatten)]
+    subject: SubjectArgs,
     /// spec, fixed or classic (as for `simulate`).
     #[arg(long, value_enum)]
     mode: Option<Mode>,
     /// Seconds the clip plays, looped, before the pictures start.
     #[arg(long, default_value_t = 1.0)]
     warmup: f32,
-    /// Move the whole character back and forth: largest offset X,Y,Z.
-    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
-    sway: Option<glam::Vec3>,
-    /// Cycles per second of --sway.
-    #[arg(long, default_value_t = 1.0)]
-    sway_hz: f32,
+    #[command(flatten)]
+    sway: SwayArgs,
     /// Seconds shown for the rest pose of a file without clips.
     #[arg(long, default_value_t = 2.0)]
     duration: f32,
@@ -73,17 +60,14 @@ pub fn run(a: Args) -> Result<(), String> {
         return Err(format!("--gif-fps {} must be in 1..=60", a.gif_fps));
     }
     check_output_dir(&a.out)?;
-    let subject = crate::subject::load(a.file.as_ref(), a.builtin, a.rig.as_ref())?;
-    let clip = subject.clip(a.clip.as_deref())?;
+    let (subject, clip) = a.subject.load()?;
+    let clip = clip.map(|i| &subject.clips[i]);
     let (mut sim, mode) = subject.sim(a.mode)?;
     let options = BakeOptions {
         fps: SIM_FPS,
         warmup: a.warmup,
         rest_duration: a.duration,
-        sway: a.sway.map(|amplitude| Sway {
-            amplitude,
-            frequency: a.sway_hz,
-        }),
+        sway: a.sway.sway(),
     };
     options.validate().map_err(|e| e.to_string())?;
     let duration = clip.map(|c| c.duration).unwrap_or(a.duration);

@@ -7,6 +7,7 @@ use tassel::anim::Clip;
 use tassel::dynamics::vrm::VrmSpringBones;
 use tassel::dynamics::{RigSettings, SimMode};
 use tassel::{builtin, CharacterSim, Skeleton};
+use tassel_gltf::Sway;
 
 pub struct Subject {
     /// For titles and messages.
@@ -94,14 +95,14 @@ impl Subject {
         make_sim(&self.skeleton, &self.vrm, &self.rig, mode)
     }
 
-    /// The named clip, the first clip without a name, `None` (the rest pose) for a file
-    /// without clips.
-    pub fn clip(&self, name: Option<&str>) -> Result<Option<&Clip>, String> {
+    /// The index of the named clip, or of the first clip without a name; `None` (the rest
+    /// pose) for a file without clips.
+    pub fn clip(&self, name: Option<&str>) -> Result<Option<usize>, String> {
         match name {
             Some(n) => self
                 .clips
                 .iter()
-                .find(|c| c.name == n)
+                .position(|c| c.name == n)
                 .map(Some)
                 .ok_or_else(|| {
                     let names: Vec<String> =
@@ -116,7 +117,71 @@ impl Subject {
                         }
                     )
                 }),
-            None => Ok(self.clips.first()),
+            None => Ok((!self.clips.is_empty()).then_some(0)),
         }
     }
+}
+
+/// `FILE | --builtin`, `--clip`, `--rig`: what `render` and `plot` play.
+#[derive(clap::Args)]
+pub struct SubjectArgs {
+    /// The model (.glb, .gltf, .vrm); omit with --builtin.
+    file: Option<PathBuf>,
+    /// Use the embedded character (its own rig unless --rig is given).
+    #[arg(long)]
+    pub builtin: bool,
+    /// The clip to play. Default: the first; a file without clips holds its rest pose.
+    #[arg(long)]
+    clip: Option<String>,
+    /// Rig file (TOML); optional for a VRM.
+    #[arg(long)]
+    rig: Option<PathBuf>,
+}
+
+impl SubjectArgs {
+    /// The character and the chosen clip (`None`: the rest pose).
+    pub fn load(&self) -> Result<(Subject, Option<usize>), String> {
+        let subject = load(self.file.as_ref(), self.builtin, self.rig.as_ref())?;
+        let clip = subject.clip(self.clip.as_deref())?;
+        Ok((subject, clip))
+    }
+}
+
+/// `--sway X,Y,Z --sway-hz F`: the whole character moved back and forth.
+#[derive(clap::Args)]
+pub struct SwayArgs {
+    /// Move the whole character back and forth: the largest offset as X,Y,Z in the file's
+    /// units (e.g. 0.1,0,0). `bake` keys the root nodes with the motion. Gives the springs
+    /// of a file without clips something to swing from.
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    sway: Option<glam::Vec3>,
+    /// Cycles per second of --sway.
+    #[arg(long, default_value_t = 1.0)]
+    sway_hz: f32,
+}
+
+impl SwayArgs {
+    pub fn sway(&self) -> Option<Sway> {
+        self.sway.map(|amplitude| Sway {
+            amplitude,
+            frequency: self.sway_hz,
+        })
+    }
+}
+
+/// `X,Y,Z` as a vector.
+pub fn parse_vec3(text: &str) -> Result<glam::Vec3, String> {
+    let parts: Vec<&str> = text.split(',').map(str::trim).collect();
+    let bad = || format!("'{text}' is not X,Y,Z (three numbers separated by commas)");
+    if parts.len() != 3 {
+        return Err(bad());
+    }
+    let mut v = [0.0f32; 3];
+    for (i, p) in parts.iter().enumerate() {
+        v[i] = p.parse().map_err(|_| bad())?;
+        if !v[i].is_finite() {
+            return Err(bad());
+        }
+    }
+    Ok(glam::Vec3::from_array(v))
 }
