@@ -114,26 +114,10 @@ impl Canvas {
 
     /// Text with its top-left corner at (`x`, `y`), each font pixel `scale` pixels.
     pub fn text(&mut self, x: i64, y: i64, s: &str, scale: usize, c: Rgb) {
-        let advance = (GLYPH.0 as i64 + 1) * scale as i64;
-        for (k, ch) in s.chars().enumerate() {
-            let Some(rows) = glyph(ch) else { continue };
-            let gx = x + k as i64 * advance;
-            for (row, bits) in rows.iter().enumerate() {
-                for col in 0..GLYPH.0 {
-                    if bits & (1 << (GLYPH.0 - 1 - col)) != 0 {
-                        for dy in 0..scale {
-                            for dx in 0..scale {
-                                self.set(
-                                    gx + (col * scale + dx) as i64,
-                                    y + (row * scale + dy) as i64,
-                                    c,
-                                );
-                            }
-                        }
-                    }
-                }
-            }
-        }
+        let advance = (GLYPH.0 + 1) * scale;
+        for_each_font_pixel(s, scale, |k, col, row| {
+            self.set(x + (k * advance + col) as i64, y + row as i64, c)
+        });
     }
 
     /// Width of `s` drawn by [`Canvas::text`] at `scale`.
@@ -146,29 +130,13 @@ impl Canvas {
         }
     }
 
-    /// Text drawn top to bottom, rotated a quarter turn counter-clockwise (a y-axis label),
+    /// Text drawn bottom to top, rotated a quarter turn counter-clockwise (a y-axis label),
     /// its bottom-left corner at (`x`, `y`).
     pub fn text_up(&mut self, x: i64, y: i64, s: &str, scale: usize, c: Rgb) {
-        let advance = (GLYPH.0 as i64 + 1) * scale as i64;
-        for (k, ch) in s.chars().enumerate() {
-            let Some(rows) = glyph(ch) else { continue };
-            let gy = y - k as i64 * advance;
-            for (row, bits) in rows.iter().enumerate() {
-                for col in 0..GLYPH.0 {
-                    if bits & (1 << (GLYPH.0 - 1 - col)) != 0 {
-                        for dy in 0..scale {
-                            for dx in 0..scale {
-                                self.set(
-                                    x + (row * scale + dx) as i64,
-                                    gy - (col * scale + dy) as i64,
-                                    c,
-                                );
-                            }
-                        }
-                    }
-                }
-            }
-        }
+        let advance = (GLYPH.0 + 1) * scale;
+        for_each_font_pixel(s, scale, |k, col, row| {
+            self.set(x + row as i64, y - (k * advance + col) as i64, c)
+        });
     }
 
     /// Copies `other` onto this canvas with its top-left corner at (`x`, `y`).
@@ -195,6 +163,25 @@ impl Canvas {
             w.write_image_data(&self.px).map_err(|e| e.to_string())?;
         }
         Ok(out)
+    }
+}
+
+/// Calls `f(character index, column, row)` for every lit pixel of `s` at `scale` (column
+/// and row in pixels within the character's cell).
+fn for_each_font_pixel(s: &str, scale: usize, mut f: impl FnMut(usize, usize, usize)) {
+    for (k, ch) in s.chars().enumerate() {
+        let Some(rows) = glyph(ch) else { continue };
+        for (row, bits) in rows.iter().enumerate() {
+            for col in 0..GLYPH.0 {
+                if bits & (1 << (GLYPH.0 - 1 - col)) != 0 {
+                    for dy in 0..scale {
+                        for dx in 0..scale {
+                            f(k, col * scale + dx, row * scale + dy);
+                        }
+                    }
+                }
+            }
+        }
     }
 }
 
