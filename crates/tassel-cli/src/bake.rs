@@ -68,11 +68,7 @@ pub fn run(a: Args) -> Result<(), String> {
     let mut baked = Vec::new();
     let mut summary = Vec::new();
     for source in sources {
-        let name = match source {
-            BakeSource::Clip(i) => model.clips[i].name.clone(),
-            BakeSource::Rest if a.sway.sway().is_some() => "sway".to_string(),
-            BakeSource::Rest => "rest".to_string(),
-        };
+        let name = source.name(&model, &options);
         let mut bar = Progress::new(&format!("baking '{name}'"));
         let clip = bake_clip(&model, &mut sim, source, &options, &mut |d, t| {
             bar.update(d, t)

@@ -4,8 +4,8 @@
 use std::path::Path;
 
 /// Fails early (before any long work) when `path` cannot be an output file: its folder
-/// does not exist, or it is a folder.
-pub fn check_output_dir(path: &Path) -> Result<(), String> {
+/// does not exist, or it is a folder. Returns the folder.
+pub fn check_output_dir(path: &Path) -> Result<&Path, String> {
     let dir = path
         .parent()
         .filter(|d| !d.as_os_str().is_empty())
@@ -20,16 +20,12 @@ pub fn check_output_dir(path: &Path) -> Result<(), String> {
     if path.is_dir() {
         return Err(format!("{}: is a folder, not a file", path.display()));
     }
-    Ok(())
+    Ok(dir)
 }
 
 /// Writes `bytes` to `path` atomically; on any error no file is left at `path`.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), String> {
-    check_output_dir(path)?;
-    let dir = path
-        .parent()
-        .filter(|d| !d.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
+    let dir = check_output_dir(path)?;
     let name = path
         .file_name()
         .ok_or_else(|| format!("{}: not a file path", path.display()))?;

@@ -145,16 +145,7 @@ pub fn run(a: Args) -> Result<(), String> {
         (Some(path), false) => {
             let model = tassel_gltf::load(path).map_err(|e| e.to_string())?;
             let vrm = model.vrm.map(|v| v.springs);
-            let rig = match &a.rig {
-                Some(p) => read_rig(p)?,
-                None if vrm.is_some() => RigSettings::default(),
-                None => {
-                    return Err(format!(
-                        "{}: the file has no VRM spring bones; give --rig RIG.toml",
-                        path.display()
-                    ))
-                }
-            };
+            let rig = crate::subject::rig_or_vrm(a.rig.as_ref(), vrm.is_some(), path)?;
             (model.skeleton, rig, model.joint_to_node, vrm)
         }
     };

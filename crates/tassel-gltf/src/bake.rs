@@ -116,6 +116,21 @@ pub enum BakeSource {
     Rest,
 }
 
+impl BakeSource {
+    /// The baked clip's name: the clip's own, or `rest` (`sway` with a sway).
+    pub fn name(&self, model: &Model, options: &BakeOptions) -> String {
+        match *self {
+            BakeSource::Clip(i) => model
+                .clips
+                .get(i)
+                .map(|c| c.name.clone())
+                .unwrap_or_default(),
+            BakeSource::Rest if options.sway.is_some() => "sway".to_string(),
+            BakeSource::Rest => "rest".to_string(),
+        }
+    }
+}
+
 /// The key times of a bake: `k / fps` up to the duration, the last key exactly at the
 /// duration (a clip of length 0 gets one key).
 pub fn key_times(duration: f32, fps: f32) -> Vec<f32> {
@@ -228,7 +243,7 @@ pub fn bake_clip(
             model.skeleton.len()
         )));
     }
-    let (clip, name, duration, merge_into) = match source {
+    let (clip, duration, merge_into) = match source {
         BakeSource::Clip(i) => {
             let clip = model.clips.get(i).ok_or_else(|| {
                 invalid(format!(
@@ -236,17 +251,11 @@ pub fn bake_clip(
                     model.clips.len()
                 ))
             })?;
-            (Some(clip), clip.name.clone(), clip.duration, Some(i))
+            (Some(clip), clip.duration, Some(i))
         }
-        BakeSource::Rest => {
-            let name = if options.sway.is_some() {
-                "sway"
-            } else {
-                "rest"
-            };
-            (None, name.to_string(), options.rest_duration, None)
-        }
+        BakeSource::Rest => (None, options.rest_duration, None),
     };
+    let name = source.name(model, options);
     let err = |e: String| invalid(format!("clip '{name}': {e}"));
     let times = key_times(duration, options.fps);
     let joints = sim.simulated_joints();
