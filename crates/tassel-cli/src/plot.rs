@@ -13,7 +13,8 @@ use tassel_render::{Chart, ChartSeries, PALETTE};
 pub struct Args {
     #[command(flatten)]
     subject: SubjectArgs,
-    /// The joint whose displacement is plotted. Default: the deepest simulated joint.
+    /// The joint whose displacement is plotted. Default: the deepest joint of a chain or
+    /// VRM spring (else of any solver).
     #[arg(long)]
     joint: Option<String>,
     /// Modes to compare, comma-separated. Default: fixed,classic (spec,fixed for a model
@@ -60,7 +61,7 @@ pub fn run(a: Args) -> Result<(), String> {
         Some(d) => return Err(format!("--duration {d} must be in (0, 600] seconds")),
         None => clip.map(|c| c.duration).filter(|d| *d > 0.0).unwrap_or(3.0),
     };
-    // The joint: named, or the deepest one a solver moves.
+    // The joint: named, or the deepest chain or VRM spring joint.
     let (probe, _) = subject.sim(Some(modes[0]))?;
     let simulated = probe.simulated_joints();
     let sk = &subject.skeleton;

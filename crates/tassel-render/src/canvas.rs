@@ -139,19 +139,6 @@ impl Canvas {
         });
     }
 
-    /// Copies `other` onto this canvas with its top-left corner at (`x`, `y`).
-    pub fn blit(&mut self, other: &Canvas, x: usize, y: usize) {
-        for row in 0..other.h {
-            if y + row >= self.h {
-                break;
-            }
-            let n = other.w.min(self.w.saturating_sub(x));
-            let src = &other.px[row * other.w * 3..(row * other.w + n) * 3];
-            let d = ((y + row) * self.w + x) * 3;
-            self.px[d..d + n * 3].copy_from_slice(src);
-        }
-    }
-
     /// The canvas as PNG bytes.
     pub fn png(&self) -> Result<Vec<u8>, String> {
         let mut out = Vec::new();
