@@ -67,58 +67,43 @@ impl CharacterSim {
         let cloth_state = ClothState::new(&cloths);
         rig.validate_for(&skeleton)?;
         let ropes = Ropes::new(&skeleton, rig)?;
-        // One solver per bone: a cloth or rope bone must not also be a chain's or a
-        // spring's (or both a cloth's and a rope's).
-        let cloth_joints: Vec<usize> = cloths.simulated_joints().collect();
-        if let Some(j) = ropes.simulated_joints().find(|j| cloth_joints.contains(j)) {
-            return Err(Error::InvalidParameter(format!(
-                "bone '{}' is simulated by a cloth and by a rope",
-                skeleton.name(j)
-            )));
-        }
-        for j in cloths.simulated_joints().chain(ropes.simulated_joints()) {
-            let in_chain = (0..chains.point_count()).any(|p| {
-                let info = chains.point(p);
-                info.joint == Some(j) && info.parent.is_some()
-            });
-            let in_spring = rig
-                .springs
-                .iter()
-                .any(|s| skeleton.find(&s.bone) == Some(j));
-            if in_chain || in_spring {
-                return Err(Error::InvalidParameter(format!(
-                    "bone '{}' is simulated by a cloth or rope and by a {}",
-                    skeleton.name(j),
-                    if in_chain { "chain" } else { "spring" }
-                )));
-            }
-        }
-        for j in vrm.simulated_joints() {
-            let other = if (0..chains.point_count()).any(|p| {
-                let info = chains.point(p);
-                info.joint == Some(j) && info.parent.is_some()
-            }) || chains.rotating_joints().any(|(rj, _, _)| rj == j)
-            {
-                Some("chain")
-            } else if rig
-                .springs
-                .iter()
-                .any(|s| skeleton.find(&s.bone) == Some(j))
-            {
-                Some("spring")
-            } else if cloth_joints.contains(&j) {
-                Some("cloth")
-            } else if ropes.simulated_joints().any(|r| r == j) {
-                Some("rope")
-            } else {
-                None
-            };
-            if let Some(other) = other {
-                return Err(Error::InvalidParameter(format!(
-                    "bone '{}' is simulated by a VRM spring and by a {other} of the rig file",
+        // One solver per bone, checked in one pass over an owner table (a rig may list
+        // thousands of bones). A chain owns the joints it moves and the joints it turns
+        // (its roots included); several chains may share a root, several cloths a bone.
+        let mut owner: Vec<Option<&'static str>> = vec![None; skeleton.len()];
+        let mut claim = |j: usize, who: &'static str| -> Result<()> {
+            match owner[j] {
+                Some(other) if other != who => Err(Error::InvalidParameter(format!(
+                    "bone '{}' is simulated by a {other} and by a {who}; a bone belongs \
+                     to one solver",
                     skeleton.name(j)
-                )));
+                ))),
+                _ => {
+                    owner[j] = Some(who);
+                    Ok(())
+                }
             }
+        };
+        for j in vrm.simulated_joints() {
+            claim(j, "VRM spring")?;
+        }
+        for p in 0..chains.point_count() {
+            let info = chains.point(p);
+            if let (Some(j), Some(_)) = (info.joint, info.parent) {
+                claim(j, "chain")?;
+            }
+        }
+        for (j, _, _) in chains.rotating_joints() {
+            claim(j, "chain")?;
+        }
+        for i in 0..springs.len() {
+            claim(springs.joint(i), "spring")?;
+        }
+        for j in cloths.simulated_joints() {
+            claim(j, "cloth")?;
+        }
+        for j in ropes.simulated_joints() {
+            claim(j, "rope")?;
         }
         let pose = Pose::rest(&skeleton);
         let animated_models = pose.models.clone();
@@ -152,6 +137,25 @@ impl CharacterSim {
                 expected: self.skeleton.len(),
                 got: animated.len(),
             });
+        }
+        // Checked here, once, before any solver state is touched: a bad frame is an error
+        // and the next good frame carries on from where the last good one left off.
+        if let Some(j) = animated.iter().position(|t| !t.within_limits()) {
+            return Err(Error::NonFinite(format!(
+                "animated pose of joint '{}' is not finite, not a unit rotation, or lies \
+                 beyond {:e}",
+                self.skeleton.name(j),
+                crate::limits::MAX_COORDINATE
+            )));
+        }
+        if !component.within_limits() {
+            return Err(Error::NonFinite(format!(
+                "character transform is not finite or lies beyond {:e}",
+                crate::limits::MAX_COORDINATE
+            )));
+        }
+        if !(dt.is_finite() && dt >= 0.0) {
+            return Err(Error::InvalidTimeStep(dt));
         }
         self.pose.locals.copy_from_slice(animated);
         LocalToModelJob {

@@ -21,6 +21,7 @@ pub mod controller;
 pub mod dynamics;
 mod error;
 mod instance;
+pub mod limits;
 pub mod math;
 mod pose;
 pub mod rng;

@@ -130,6 +130,17 @@ impl Transform {
     pub fn is_finite(&self) -> bool {
         self.translation.is_finite() && self.rotation.is_finite() && self.scale.is_finite()
     }
+
+    /// Finite, a unit rotation (length within 10 %: a quaternion far from unit length
+    /// scales every vector it turns), and every translation coordinate and scale factor
+    /// within [`crate::limits::MAX_COORDINATE`]: the range Tassel accepts as input.
+    pub fn within_limits(&self) -> bool {
+        let max = crate::limits::MAX_COORDINATE;
+        self.is_finite()
+            && (self.rotation.length_squared() - 1.0).abs() <= 0.21
+            && self.translation.abs().max_element() <= max
+            && self.scale.abs().max_element() <= max
+    }
 }
 
 impl core::ops::Mul for Transform {

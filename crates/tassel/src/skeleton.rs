@@ -73,6 +73,16 @@ impl Skeleton {
             if !rest[i].is_finite() {
                 return Err(Error::NonFinite(format!("rest pose of joint '{name}'")));
             }
+            if !rest[i].within_limits() {
+                return Err(Error::InvalidParameter(format!(
+                    "rest pose of joint '{name}': translation {} or scale {} is beyond the \
+                     limit of {:e}, or rotation {} is not a unit quaternion",
+                    rest[i].translation,
+                    rest[i].scale,
+                    crate::limits::MAX_COORDINATE,
+                    rest[i].rotation
+                )));
+            }
         }
         Ok(Self {
             names,

@@ -439,5 +439,9 @@ fn rope_on_a_tilted_bone_settles_hanging_straight_down() {
     let e = CharacterSim::new(sk.clone(), &both)
         .unwrap_err()
         .to_string();
-    assert!(e.contains("'r3'"), "{e}");
+    // r2 is the chain's root (the chain turns it) and a rope bone; r3 is moved by both.
+    assert!(
+        (e.contains("'r2'") || e.contains("'r3'")) && e.contains("chain") && e.contains("rope"),
+        "{e}"
+    );
 }

@@ -37,9 +37,15 @@ pub trait Animatable: Copy {
     fn finish(self) -> Self {
         self
     }
+    /// Whether a key value is one Tassel accepts: finite, and for translations and scales
+    /// within [`crate::limits::MAX_COORDINATE`].
+    fn acceptable(&self) -> bool;
 }
 
 impl Animatable for Vec3 {
+    fn acceptable(&self) -> bool {
+        self.is_finite() && self.abs().max_element() <= crate::limits::MAX_COORDINATE
+    }
     fn lerp_value(a: Self, b: Self, t: f32) -> Self {
         a.lerp(b, t)
     }
@@ -49,6 +55,9 @@ impl Animatable for Vec3 {
 }
 
 impl Animatable for Quat {
+    fn acceptable(&self) -> bool {
+        self.is_finite()
+    }
     fn lerp_value(a: Self, b: Self, t: f32) -> Self {
         slerp_shortest(a, b, t)
     }
@@ -82,6 +91,18 @@ impl<T: Animatable> Channel<T> {
         if self.times.iter().any(|t| !t.is_finite()) || self.times.windows(2).any(|w| w[1] < w[0]) {
             return Err(Error::InvalidParameter(format!(
                 "{what}: key times are not increasing"
+            )));
+        }
+        let max = crate::limits::MAX_CLIP_SECONDS;
+        if let Some(t) = self.times.iter().find(|t| !(0.0..=max).contains(*t)) {
+            return Err(Error::InvalidParameter(format!(
+                "{what}: key time {t} s is outside 0..={max} s (the limit on clip length)"
+            )));
+        }
+        if let Some(k) = self.values.iter().position(|v| !v.acceptable()) {
+            return Err(Error::InvalidParameter(format!(
+                "{what}: value {k} is not finite or is beyond the limit of {:e}",
+                crate::limits::MAX_COORDINATE
             )));
         }
         Ok(())

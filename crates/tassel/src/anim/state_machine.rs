@@ -264,6 +264,18 @@ impl StateMachine {
     pub fn from_toml_str(text: &str, clip_names: &[&str], durations: &[f32]) -> Result<Self> {
         let def: Def = toml::from_str(text)
             .map_err(|e| Error::InvalidParameter(format!("state machine: {e}")))?;
+        let max = crate::limits::MAX_STATES;
+        for (what, n) in [
+            ("parameters", def.parameters.len()),
+            ("states", def.states.len()),
+            ("transitions", def.transitions.len()),
+        ] {
+            if n > max {
+                return Err(Error::InvalidParameter(format!(
+                    "state machine: {n} {what}, more than the limit of {max}"
+                )));
+            }
+        }
         let mut params = Vec::new();
         for (name, p) in &def.parameters {
             let kind = match p.kind.as_str() {
@@ -290,10 +302,11 @@ impl StateMachine {
                 .position(|c| *c == name)
                 .ok_or_else(|| Error::InvalidParameter(format!("{what}: no clip named '{name}'")))
         };
-        let mut states = Vec::new();
+        let mut states: Vec<State> = Vec::new();
+        let mut state_index = std::collections::HashMap::with_capacity(def.states.len());
         for s in &def.states {
             let what = format!("state '{}'", s.name);
-            if states.iter().any(|o: &State| o.name == s.name) {
+            if state_index.insert(s.name.as_str(), states.len()).is_some() {
                 return Err(Error::InvalidParameter(format!(
                     "two states are named '{}'",
                     s.name
@@ -347,9 +360,9 @@ impl StateMachine {
             ));
         }
         let state = |name: &str, what: &str| {
-            states
-                .iter()
-                .position(|s| s.name == name)
+            state_index
+                .get(name)
+                .copied()
                 .ok_or_else(|| Error::InvalidParameter(format!("{what}: no state named '{name}'")))
         };
         let mut transitions = Vec::new();

@@ -79,17 +79,26 @@ impl ParticleSettings {
         if !(0.0..=1.0).contains(&self.damping) {
             return bad("damping", format!("{} (0..=1)", self.damping));
         }
-        if !(self.time_step.is_finite() && self.time_step > 0.0 && self.time_step <= 0.1) {
-            return bad("time_step", format!("{} (0, 0.1]", self.time_step));
+        let min_step = crate::limits::MIN_TIME_STEP;
+        if !(self.time_step.is_finite() && self.time_step >= min_step && self.time_step <= 0.1) {
+            return bad("time_step", format!("{} [{min_step}, 0.1]", self.time_step));
         }
-        if self.iterations == 0 || self.iterations > 1000 {
-            return bad("iterations", format!("{} (1..=1000)", self.iterations));
+        let max_iterations = crate::limits::MAX_ITERATIONS;
+        if self.iterations == 0 || self.iterations > max_iterations {
+            return bad(
+                "iterations",
+                format!("{} (1..={max_iterations})", self.iterations),
+            );
         }
         if !(self.radius.is_finite() && self.radius >= 0.0) {
             return bad("radius", format!("{} (≥ 0)", self.radius));
         }
-        if self.max_steps_per_frame == 0 {
-            return bad("max_steps_per_frame", "0 (≥ 1)".into());
+        let max_steps = crate::limits::MAX_STEPS_PER_FRAME;
+        if !(1..=max_steps).contains(&self.max_steps_per_frame) {
+            return bad(
+                "max_steps_per_frame",
+                format!("{} (1..={max_steps})", self.max_steps_per_frame),
+            );
         }
         if !self.wind.is_finite() {
             return bad("wind", format!("{}", self.wind));

@@ -111,41 +111,28 @@ impl RigSettings {
     /// Checks parameter ranges and internal references (not bone names: see
     /// [`RigSettings::validate_for`]).
     pub fn validate(&self) -> Result<()> {
-        for c in &self.chains {
-            c.validate()?;
-        }
-        for s in &self.springs {
-            s.validate()?;
-        }
-        for r in &self.ropes {
-            r.validate()?;
-            for name in &r.colliders {
-                if !self.colliders.iter().any(|o| &o.name == name) {
-                    return Err(Error::InvalidParameter(format!(
-                        "rope '{}' names collider '{name}', which the rig does not define",
-                        r.name
-                    )));
-                }
-            }
-        }
-        for (i, c) in self.cloths.iter().enumerate() {
-            c.validate()?;
-            if self.cloths[..i].iter().any(|o| o.name == c.name) {
+        use crate::limits::{MAX_COLLIDERS, MAX_SOLVERS};
+        for (what, n) in [
+            ("chains", self.chains.len()),
+            ("springs", self.springs.len()),
+            ("cloths", self.cloths.len()),
+            ("ropes", self.ropes.len()),
+        ] {
+            if n > MAX_SOLVERS {
                 return Err(Error::InvalidParameter(format!(
-                    "two cloths are named '{}'",
-                    c.name
+                    "the rig defines {n} {what}, more than the limit of {MAX_SOLVERS}"
                 )));
             }
-            for name in &c.colliders {
-                if !self.colliders.iter().any(|o| &o.name == name) {
-                    return Err(Error::InvalidParameter(format!(
-                        "cloth '{}' names collider '{name}', which the rig does not define",
-                        c.name
-                    )));
-                }
-            }
         }
-        for (i, col) in self.colliders.iter().enumerate() {
+        if self.colliders.len() > MAX_COLLIDERS {
+            return Err(Error::InvalidParameter(format!(
+                "the rig defines {} colliders, more than the limit of {MAX_COLLIDERS}",
+                self.colliders.len()
+            )));
+        }
+        // Name sets, not scans: every check below is linear in the rig's size.
+        let mut colliders = std::collections::HashSet::with_capacity(self.colliders.len());
+        for col in &self.colliders {
             let what = format!("collider '{}'", col.name);
             col.shape.validate(&what)?;
             if !col.offset.is_finite() || !col.rotation.is_finite() || col.rotation.length() < 1e-6
@@ -154,24 +141,63 @@ impl RigSettings {
                     "{what}: offset or rotation is not finite"
                 )));
             }
-            if self.colliders[..i].iter().any(|o| o.name == col.name) {
+            if !colliders.insert(col.name.as_str()) {
                 return Err(Error::InvalidParameter(format!(
                     "two colliders are named '{}'",
                     col.name
                 )));
             }
         }
-        for c in &self.chains {
-            for name in &c.colliders {
-                if !self.colliders.iter().any(|o| &o.name == name) {
-                    return Err(Error::InvalidParameter(format!(
-                        "chain '{}' names collider '{name}', which the rig does not define",
-                        c.name
-                    )));
-                }
+        let known = |who: &str, names: &[String]| -> Result<()> {
+            match names.iter().find(|n| !colliders.contains(n.as_str())) {
+                Some(name) => Err(Error::InvalidParameter(format!(
+                    "{who} names collider '{name}', which the rig does not define"
+                ))),
+                None => Ok(()),
             }
+        };
+        for c in &self.chains {
+            c.validate()?;
+            known(&format!("chain '{}'", c.name), &c.colliders)?;
+        }
+        for s in &self.springs {
+            s.validate()?;
+        }
+        for r in &self.ropes {
+            r.validate()?;
+            known(&format!("rope '{}'", r.name), &r.colliders)?;
+        }
+        let mut cloths = std::collections::HashSet::with_capacity(self.cloths.len());
+        for c in &self.cloths {
+            c.validate()?;
+            if !cloths.insert(c.name.as_str()) {
+                return Err(Error::InvalidParameter(format!(
+                    "two cloths are named '{}'",
+                    c.name
+                )));
+            }
+            known(&format!("cloth '{}'", c.name), &c.colliders)?;
         }
         Ok(())
+    }
+
+    /// Indices into `colliders` of the named colliders, in the order named (all of them
+    /// when `names` is empty); unknown names are skipped ([`RigSettings::validate`]
+    /// reports them). One map per call, so a rig's compile stays linear in its size.
+    pub(crate) fn collider_indices(&self, names: &[String]) -> Vec<usize> {
+        if names.is_empty() {
+            return (0..self.colliders.len()).collect();
+        }
+        let index: std::collections::HashMap<&str, usize> = self
+            .colliders
+            .iter()
+            .enumerate()
+            .map(|(i, c)| (c.name.as_str(), i))
+            .collect();
+        names
+            .iter()
+            .filter_map(|n| index.get(n.as_str()).copied())
+            .collect()
     }
 
     /// [`RigSettings::validate`] plus every bone name checked against `skeleton`.

@@ -105,6 +105,7 @@ impl Ropes {
             return Ok(out);
         }
         rig.validate_for(skeleton)?;
+        let all = CompiledCollider::compile_all(skeleton, rig);
         for s in &rig.ropes {
             let missing = |n: &str| Error::MissingBone {
                 context: format!("rope '{}'", s.name),
@@ -130,12 +131,11 @@ impl Ropes {
                     s.name
                 )));
             }
-            let colliders: Vec<CompiledCollider> = CompiledCollider::compile_all(skeleton, rig)
-                .into_iter()
-                .zip(&rig.colliders)
-                .filter(|(_, c)| s.colliders.is_empty() || s.colliders.contains(&c.name))
-                .map(|(compiled, _)| compiled)
-                .collect();
+            // In the rig's order, each once.
+            let mut chosen = rig.collider_indices(&s.colliders);
+            chosen.sort_unstable();
+            chosen.dedup();
+            let colliders: Vec<CompiledCollider> = chosen.iter().map(|&i| all[i].clone()).collect();
             let mut world = ParticleWorld::new(s.world.clone());
             let rest = crate::pose::Pose::rest(skeleton);
             let m = s.mass / bones.len() as f32;

@@ -59,6 +59,7 @@ impl ChainRig {
     pub fn new(skeleton: &Skeleton, rig: &RigSettings) -> Result<Self> {
         rig.validate_for(skeleton)?;
         let rest = Pose::rest(skeleton);
+        let mut pairs = 0usize;
         let mut out = ChainRig {
             chains: Vec::new(),
             colliders: Vec::new(),
@@ -176,15 +177,16 @@ impl ChainRig {
                         .to_radians(),
                 );
             }
-            let colliders = if settings.colliders.is_empty() {
-                (0..rig.colliders.len()).collect()
-            } else {
-                settings
-                    .colliders
-                    .iter()
-                    .filter_map(|n| rig.colliders.iter().position(|c| &c.name == n))
-                    .collect()
-            };
+            let colliders = rig.collider_indices(&settings.colliders);
+            pairs = pairs.saturating_add(colliders.len().saturating_mul(end - start));
+            if pairs > crate::limits::MAX_COLLIDER_PAIRS {
+                return Err(crate::Error::InvalidParameter(format!(
+                    "chain '{}': the chains test more than {} point-collider pairs per step \
+                     (the limit)",
+                    settings.name,
+                    crate::limits::MAX_COLLIDER_PAIRS
+                )));
+            }
             out.chains.push(CompiledChain {
                 settings: settings.clone(),
                 points: start..end,

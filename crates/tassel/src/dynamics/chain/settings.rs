@@ -216,8 +216,19 @@ impl ChainSettings {
                 self.max_delta_time
             ));
         }
-        if self.max_steps_per_frame == 0 {
-            return bad("max_steps_per_frame must be at least 1".into());
+        let max_steps = crate::limits::MAX_STEPS_PER_FRAME;
+        if !(1..=max_steps).contains(&self.max_steps_per_frame) {
+            return bad(format!(
+                "max_steps_per_frame is {}; it must be 1..={max_steps}",
+                self.max_steps_per_frame
+            ));
+        }
+        let max_warmup = crate::limits::MAX_WARMUP_STEPS;
+        if self.warmup_steps > max_warmup {
+            return bad(format!(
+                "warmup_steps is {}; it must be 0..={max_warmup}",
+                self.warmup_steps
+            ));
         }
         if !self.gravity.is_finite() {
             return bad(format!("gravity {} is not finite", self.gravity));

@@ -283,14 +283,7 @@ impl ClothRig {
                     }
                 }
             }
-            let colliders = if s.colliders.is_empty() {
-                (0..rig.colliders.len()).collect()
-            } else {
-                s.colliders
-                    .iter()
-                    .filter_map(|n| rig.colliders.iter().position(|c| &c.name == n))
-                    .collect()
-            };
+            let colliders = rig.collider_indices(&s.colliders);
             out.cloths.push(CompiledCloth {
                 settings: s.clone(),
                 points: first..out.joint.len(),

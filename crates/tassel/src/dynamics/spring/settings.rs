@@ -83,12 +83,13 @@ impl SpringSettings {
                 self.owner_velocity_scale
             ));
         }
+        let min_step = crate::limits::MIN_TIME_STEP;
         if !(self.fixed_time_step.is_finite()
-            && self.fixed_time_step > 0.0
+            && self.fixed_time_step >= min_step
             && self.fixed_time_step <= 0.1)
         {
             return bad(format!(
-                "fixed_time_step is {}; it must be in (0, 0.1] s",
+                "fixed_time_step is {}; it must be in [{min_step}, 0.1] s",
                 self.fixed_time_step
             ));
         }
@@ -98,8 +99,12 @@ impl SpringSettings {
                 self.cutoff_damping
             ));
         }
-        if self.max_steps_per_frame == 0 {
-            return bad("max_steps_per_frame must be at least 1".into());
+        let max_steps = crate::limits::MAX_STEPS_PER_FRAME;
+        if !(1..=max_steps).contains(&self.max_steps_per_frame) {
+            return bad(format!(
+                "max_steps_per_frame is {}; it must be 1..={max_steps}",
+                self.max_steps_per_frame
+            ));
         }
         Ok(())
     }

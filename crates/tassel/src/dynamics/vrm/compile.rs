@@ -64,14 +64,19 @@ impl VrmRig {
         let rest = Pose::rest(skeleton);
         let mut links = Vec::new();
         let mut link_colliders = Vec::new();
+        let mut listed = vec![false; bones.colliders.len()];
         for (si, s) in bones.springs.iter().enumerate() {
             let mut cols: Vec<usize> = Vec::new();
             for &g in &s.collider_groups {
                 for &c in &bones.collider_groups[g].colliders {
-                    if !cols.contains(&c) {
+                    if !listed[c] {
+                        listed[c] = true;
                         cols.push(c);
                     }
                 }
+            }
+            for &c in &cols {
+                listed[c] = false;
             }
             for j in &s.joints {
                 let (tail_joint, tail_local) = match j.tail {

@@ -145,6 +145,20 @@ impl VrmSpringBones {
     pub fn validate_for(&self, skeleton: &Skeleton) -> Result<()> {
         let n = skeleton.len();
         let bad = |m: String| Err(Error::InvalidParameter(m));
+        use crate::limits::{MAX_COLLIDERS, MAX_SOLVERS};
+        if self.colliders.len() > MAX_COLLIDERS {
+            return bad(format!(
+                "VRM spring bones: {} colliders, more than the limit of {MAX_COLLIDERS}",
+                self.colliders.len()
+            ));
+        }
+        if self.springs.len() > MAX_SOLVERS || self.collider_groups.len() > MAX_SOLVERS {
+            return bad(format!(
+                "VRM spring bones: {} springs and {} collider groups; the limit is {MAX_SOLVERS} each",
+                self.springs.len(),
+                self.collider_groups.len()
+            ));
+        }
         let name = |j: usize| {
             if j < n {
                 format!("'{}'", skeleton.name(j))
@@ -205,6 +219,7 @@ impl VrmSpringBones {
             }
         }
         let mut owner: Vec<Option<usize>> = vec![None; n];
+        let mut pairs = 0usize;
         for (si, s) in self.springs.iter().enumerate() {
             let sname = format!("VRM spring {si} ('{}')", s.name);
             if let Some(&g) = s
@@ -215,6 +230,17 @@ impl VrmSpringBones {
                 return bad(format!(
                     "{sname}: collider group {g} does not exist ({} groups)",
                     self.collider_groups.len()
+                ));
+            }
+            let listed = s.collider_groups.iter().fold(0usize, |acc, &g| {
+                acc.saturating_add(self.collider_groups[g].colliders.len())
+            });
+            pairs = pairs.saturating_add(listed.saturating_mul(s.joints.len()));
+            if pairs > crate::limits::MAX_COLLIDER_PAIRS {
+                return bad(format!(
+                    "{sname}: the springs test more than {} joint-collider pairs per step \
+                     (the limit)",
+                    crate::limits::MAX_COLLIDER_PAIRS
                 ));
             }
             if let Some(c) = s.center {
@@ -338,10 +364,12 @@ impl VrmOptions {
                 self.step_rate
             )));
         }
-        if self.max_steps_per_frame == 0 {
-            return Err(Error::InvalidParameter(
-                "VRM max_steps_per_frame must be at least 1".into(),
-            ));
+        let max_steps = crate::limits::MAX_STEPS_PER_FRAME;
+        if !(1..=max_steps).contains(&self.max_steps_per_frame) {
+            return Err(Error::InvalidParameter(format!(
+                "VRM max_steps_per_frame {} must be 1..={max_steps}",
+                self.max_steps_per_frame
+            )));
         }
         if !(self.teleport_distance.is_finite() && self.teleport_distance >= 0.0) {
             return Err(Error::InvalidParameter(format!(
