@@ -131,6 +131,10 @@ impl BakeSource {
     }
 }
 
+/// The most keys (frames × simulated bones) one baked clip may hold (8 M: with the
+/// translations, about 240 MB before export).
+pub const MAX_BAKE_KEYS: usize = 1 << 23;
+
 /// The key times of a bake: `k / fps` up to the duration, the last key exactly at the
 /// duration (a clip of length 0 gets one key).
 pub fn key_times(duration: f32, fps: f32) -> Vec<f32> {
@@ -257,8 +261,17 @@ pub fn bake_clip(
     };
     let name = source.name(model, options);
     let err = |e: String| invalid(format!("clip '{name}': {e}"));
-    let times = key_times(duration, options.fps);
     let joints = sim.simulated_joints();
+    // Checked before anything is played or allocated: keys = frames × bones.
+    let frames = (duration * options.fps).ceil() as usize + 1;
+    if frames.saturating_mul(joints.len().max(1)) > MAX_BAKE_KEYS {
+        return Err(err(format!(
+            "{frames} frames × {} bones is more than the limit of {MAX_BAKE_KEYS} keys per clip; \
+             bake at a lower --fps or a shorter clip",
+            joints.len()
+        )));
+    }
+    let times = key_times(duration, options.fps);
     // With a sway the roots carry the character's motion in the file.
     let roots: Vec<usize> = match options.sway {
         Some(_) => (0..model.skeleton.len())

@@ -286,11 +286,11 @@ fn merge_buffers(src: &ExportSource) -> Result<ExportSource, GltfError> {
         if uri.starts_with("data:") {
             continue;
         }
-        let path = src.base_dir.clone().unwrap_or_default().join(&uri);
-        let bytes = std::fs::read(&path).map_err(|source| GltfError::Io {
-            path: path.display().to_string(),
-            source,
-        })?;
+        let bytes = crate::uri::read_uri(&uri, src.base_dir.as_deref(), crate::MAX_FILE_BYTES)
+            .map_err(|message| GltfError::Invalid {
+                path: format!("image {i}"),
+                message,
+            })?;
         let mime = if uri.to_ascii_lowercase().ends_with(".png") {
             "image/png"
         } else {

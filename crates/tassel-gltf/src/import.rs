@@ -1,8 +1,11 @@
 //! Reading glTF / GLB into a skeleton, skins and clips.
 
+use crate::accessor;
 use crate::error::GltfError;
-use base64::Engine;
 use glam::{Mat4, Quat, Vec3};
+use gltf::accessor::DataType::{self, F32, I16, I8, U16, U8};
+use gltf::accessor::Dimensions::{self, Mat4 as Mat4D, Scalar, Vec3 as Vec3D, Vec4 as Vec4D};
+use gltf::animation::Property;
 use std::path::Path;
 use tassel::anim::{Channel, Clip, Interpolation, JointTrack};
 use tassel::{Skeleton, SkeletonBuilder, Transform};
@@ -42,13 +45,26 @@ pub struct Model {
 }
 
 /// Loads a `.gltf`, `.glb` or `.vrm` file.
+///
+/// A file larger than [`MAX_FILE_BYTES`] is refused before it is read.
 pub fn load(path: &Path) -> Result<Model, GltfError> {
-    let bytes = std::fs::read(path).map_err(|source| GltfError::Io {
+    let io = |source| GltfError::Io {
         path: path.display().to_string(),
         source,
-    })?;
+    };
+    let bytes = crate::uri::read_at_most(path, MAX_FILE_BYTES + 1).map_err(io)?;
+    if bytes.len() > MAX_FILE_BYTES {
+        return Err(GltfError::Invalid {
+            path: path.display().to_string(),
+            message: format!("the file is larger than the limit of {MAX_FILE_BYTES} bytes"),
+        });
+    }
     load_slice(&bytes, path.parent(), &path.display().to_string())
 }
+
+/// The largest glTF/GLB file, and the most bytes all of one file's buffers may hold
+/// together (512 MiB).
+pub const MAX_FILE_BYTES: usize = 512 << 20;
 
 /// Loads from bytes; `base_dir` resolves external buffers; `name` is used in messages.
 pub fn load_slice(bytes: &[u8], base_dir: Option<&Path>, name: &str) -> Result<Model, GltfError> {
@@ -56,18 +72,38 @@ pub fn load_slice(bytes: &[u8], base_dir: Option<&Path>, name: &str) -> Result<M
         path: name.to_string(),
         message,
     };
+    // The gltf crate subtracts the header size from the GLB length field unchecked (found
+    // by fuzzing: an overflow panic in debug builds).
+    if let Some(length) = bytes.get(8..12).filter(|_| bytes.starts_with(b"glTF")) {
+        let length = u32::from_le_bytes([length[0], length[1], length[2], length[3]]);
+        if length < 12 {
+            return Err(invalid(format!(
+                "the GLB header gives a length of {length} bytes, less than the header itself"
+            )));
+        }
+    }
     let gltf =
         gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| invalid(e.to_string()))?;
     validate(&gltf).map_err(invalid)?;
     let doc = &gltf.document;
     let mut buffers: Vec<Vec<u8>> = Vec::new();
+    let mut total = 0usize;
     for b in doc.buffers() {
+        total = total.saturating_add(b.length());
+        if total > MAX_FILE_BYTES {
+            return Err(invalid(format!(
+                "buffer {} takes the file's buffers past the limit of {MAX_FILE_BYTES} bytes",
+                b.index()
+            )));
+        }
         let data = match b.source() {
             gltf::buffer::Source::Bin => gltf
                 .blob
                 .clone()
                 .ok_or_else(|| invalid("GLB has no BIN chunk".into()))?,
-            gltf::buffer::Source::Uri(uri) => read_uri(uri, base_dir).map_err(invalid)?,
+            gltf::buffer::Source::Uri(uri) => {
+                crate::uri::read_uri(uri, base_dir, b.length()).map_err(invalid)?
+            }
         };
         if data.len() < b.length() {
             return Err(invalid(format!(
@@ -82,7 +118,7 @@ pub fn load_slice(bytes: &[u8], base_dir: Option<&Path>, name: &str) -> Result<M
     // Accessor reads must stay inside the buffers: check views first so the reader never
     // sees an out-of-range view.
     for v in doc.views() {
-        let end = v.offset() + v.length();
+        let end = v.offset().saturating_add(v.length());
         if end > buffers[v.buffer().index()].len() {
             return Err(invalid(format!(
                 "bufferView {} runs past the end of its buffer",
@@ -155,9 +191,15 @@ pub fn load_slice(bytes: &[u8], base_dir: Option<&Path>, name: &str) -> Result<M
     }
 
     let get = |b: gltf::Buffer| buffers.get(b.index()).map(|v| v.as_slice());
+    let buffer_len = |i: usize| buffers.get(i).map_or(0, Vec::len);
     let mut skins = Vec::new();
+    let mut in_skin = vec![false; skeleton.len()];
     for skin in doc.skins() {
         let joints: Vec<usize> = skin.joints().map(|j| node_to_joint[j.index()]).collect();
+        if let Some(acc) = skin.inverse_bind_matrices() {
+            let what = format!("skin {} inverse bind matrices", skin.index());
+            accessor::check(&acc, &[(F32, Mat4D)], &buffer_len, &what).map_err(invalid)?;
+        }
         let inverse_bind: Vec<Mat4> = match skin.reader(get).read_inverse_bind_matrices() {
             Some(it) => it.map(|m| Mat4::from_cols_array_2d(&m)).collect(),
             None => vec![Mat4::IDENTITY; joints.len()],
@@ -170,12 +212,26 @@ pub fn load_slice(bytes: &[u8], base_dir: Option<&Path>, name: &str) -> Result<M
         }
         // A skin normally hangs from one root; joints whose parent is outside the skin
         // beyond the first are worth a look (they move with nodes the skin does not list).
+        // (A set, not `joints.contains`: a skin may list thousands of joints.)
+        for &j in &joints {
+            if std::mem::replace(&mut in_skin[j], true) {
+                return Err(invalid(format!(
+                    "skin {} lists joint '{}' twice (skin joints must be unique)",
+                    skin.index(),
+                    skeleton.name(j)
+                )));
+            }
+        }
         let roots: Vec<usize> = joints
             .iter()
             .copied()
-            .filter(|&j| skeleton.parent(j).is_none_or(|p| !joints.contains(&p)))
+            .filter(|&j| skeleton.parent(j).is_none_or(|p| !in_skin[p]))
             .collect();
-        for &j in roots.iter().skip(1) {
+        for &j in &joints {
+            in_skin[j] = false;
+        }
+        // The first few by name, then how many (a broken skin may have thousands).
+        for &j in roots.iter().skip(1).take(8) {
             warnings.push(format!(
                 "skin {} ('{}'): joint '{}' has no parent in the skin ({} such joints)",
                 skin.index(),
@@ -206,6 +262,31 @@ pub fn load_slice(bytes: &[u8], base_dir: Option<&Path>, name: &str) -> Result<M
                 gltf::animation::Interpolation::Linear => Interpolation::Linear,
                 gltf::animation::Interpolation::CubicSpline => Interpolation::CubicSpline,
             };
+            let what = format!(
+                "animation '{clip_name}' node {}",
+                ch.target().node().index()
+            );
+            let sampler = ch.sampler();
+            accessor::check(
+                &sampler.input(),
+                &[(F32, Scalar)],
+                &buffer_len,
+                &format!("{what} key times"),
+            )
+            .map_err(invalid)?;
+            let normalized = [F32, I8, U8, I16, U16];
+            let outputs: Vec<(DataType, Dimensions)> = match ch.target().property() {
+                Property::Translation | Property::Scale => vec![(F32, Vec3D)],
+                Property::Rotation => normalized.iter().map(|&t| (t, Vec4D)).collect(),
+                Property::MorphTargetWeights => normalized.iter().map(|&t| (t, Scalar)).collect(),
+            };
+            accessor::check(
+                &sampler.output(),
+                &outputs,
+                &buffer_len,
+                &format!("{what} key values"),
+            )
+            .map_err(invalid)?;
             let reader = ch.reader(get);
             let times: Vec<f32> = reader
                 .read_inputs()
@@ -226,10 +307,6 @@ pub fn load_slice(bytes: &[u8], base_dir: Option<&Path>, name: &str) -> Result<M
             };
             let track = &mut tracks[idx];
             use gltf::animation::util::ReadOutputs;
-            let what = format!(
-                "animation '{clip_name}' node {}",
-                ch.target().node().index()
-            );
             match reader.read_outputs() {
                 Some(ReadOutputs::Translations(it)) => {
                     let c = Channel {
@@ -290,6 +367,7 @@ pub fn load_slice(bytes: &[u8], base_dir: Option<&Path>, name: &str) -> Result<M
     let meshes = crate::mesh::read_meshes(
         doc,
         &buffers,
+        &buffer_len,
         &skeleton,
         &node_to_joint,
         &mut warnings,
@@ -322,6 +400,26 @@ fn handled_here(ext: &str) -> bool {
 fn validate(gltf: &gltf::Gltf) -> Result<(), String> {
     use gltf::json::validation::{Error as V, Validate};
     let root = gltf.document.as_json();
+    // gltf-json 1.4's own validation indexes `accessors` with a primitive's POSITION
+    // before checking it (found by fuzzing: an index past the end panicked there).
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, prim) in mesh.primitives.iter().enumerate() {
+            for (semantic, index) in &prim.attributes {
+                if index.value() >= root.accessors.len() {
+                    let semantic = match semantic {
+                        gltf::json::validation::Checked::Valid(s) => format!("{s:?}"),
+                        gltf::json::validation::Checked::Invalid => "?".into(),
+                    };
+                    return Err(format!(
+                        "invalid glTF: meshes[{m}].primitives[{p}].attributes[{semantic}]: \
+                         accessor {} does not exist ({} accessors)",
+                        index.value(),
+                        root.accessors.len()
+                    ));
+                }
+            }
+        }
+    }
     let mut errors = Vec::new();
     root.validate(root, gltf::json::Path::new, &mut |path, error| {
         errors.push((path(), error))
@@ -335,6 +433,25 @@ fn validate(gltf: &gltf::Gltf) -> Result<(), String> {
         });
         !(required && *error == V::Unsupported)
     });
+    // gltf-json 1.4 does not validate animation channel targets, and the gltf crate
+    // unwraps them (found by fuzzing: a path of "tr0anslation" panicked).
+    for (a, anim) in root.animations.iter().enumerate() {
+        for (c, ch) in anim.channels.iter().enumerate() {
+            let at = || {
+                gltf::json::Path::new()
+                    .field("animations")
+                    .index(a)
+                    .field("channels")
+                    .index(c)
+            };
+            if ch.target.node.value() >= root.nodes.len() {
+                errors.push((at().field("target").field("node"), V::IndexOutOfBounds));
+            }
+            if ch.target.path == gltf::json::validation::Checked::Invalid {
+                errors.push((at().field("target").field("path"), V::Invalid));
+            }
+        }
+    }
     match errors.first() {
         None => Ok(()),
         Some(_) => Err(format!(
@@ -356,35 +473,4 @@ fn raw_json(bytes: &[u8]) -> Option<serde_json::Value> {
     } else {
         serde_json::from_slice(bytes).ok()
     }
-}
-
-fn read_uri(uri: &str, base_dir: Option<&Path>) -> Result<Vec<u8>, String> {
-    if let Some(rest) = uri.strip_prefix("data:") {
-        let (_, payload) = rest
-            .split_once(";base64,")
-            .ok_or_else(|| format!("data URI without base64: {}", &uri[..uri.len().min(40)]))?;
-        return base64::engine::general_purpose::STANDARD
-            .decode(payload)
-            .map_err(|e| format!("bad base64 in data URI: {e}"));
-    }
-    let path = base_dir.unwrap_or(Path::new(".")).join(percent_decode(uri));
-    std::fs::read(&path).map_err(|e| format!("buffer '{}': {e}", path.display()))
-}
-
-fn percent_decode(s: &str) -> String {
-    let b = s.as_bytes();
-    let mut out = Vec::with_capacity(b.len());
-    let mut i = 0;
-    while i < b.len() {
-        if b[i] == b'%' && i + 2 < b.len() {
-            if let Ok(v) = u8::from_str_radix(&s[i + 1..i + 3], 16) {
-                out.push(v);
-                i += 3;
-                continue;
-            }
-        }
-        out.push(b[i]);
-        i += 1;
-    }
-    String::from_utf8_lossy(&out).into_owned()
 }

@@ -9,16 +9,20 @@
 //! - [`bake_clip`]: play a clip through a [`tassel::CharacterSim`] and key the bones it
 //!   simulates.
 
+mod accessor;
 mod bake;
 mod error;
 mod export;
 mod import;
 mod mesh;
+mod uri;
 mod vrm;
 
-pub use bake::{bake_clip, key_times, play, BakeOptions, BakeSource, PlayedFrame, Sway};
+pub use bake::{
+    bake_clip, key_times, play, BakeOptions, BakeSource, PlayedFrame, Sway, MAX_BAKE_KEYS,
+};
 pub use error::GltfError;
 pub use export::{export_glb, BakedClip, BakedTrack, BoneMesh, ExportSource};
-pub use import::{load, load_slice, Model, SkinInfo};
+pub use import::{load, load_slice, Model, SkinInfo, MAX_FILE_BYTES};
 pub use mesh::MeshInstance;
 pub use vrm::{read_spring_bones, VrmInfo, VrmVersion, VRM0_TAIL_LENGTH};

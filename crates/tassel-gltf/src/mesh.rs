@@ -2,6 +2,8 @@
 
 use crate::GltfError;
 use glam::{Mat4, Vec3};
+use gltf::accessor::DataType::{F32, U16, U32, U8};
+use gltf::accessor::Dimensions::{self, Scalar};
 use tassel::controller::{LevelCollider, LevelShape};
 use tassel::Skeleton;
 
@@ -38,6 +40,7 @@ impl MeshInstance {
 pub(crate) fn read_meshes(
     doc: &gltf::Document,
     buffers: &[Vec<u8>],
+    buffer_len: &dyn Fn(usize) -> usize,
     skeleton: &Skeleton,
     node_to_joint: &[usize],
     warnings: &mut Vec<String>,
@@ -71,6 +74,17 @@ pub(crate) fn read_meshes(
                     prim.mode()
                 ));
                 continue;
+            }
+            let Some(acc) = prim.get(&gltf::Semantic::Positions) else {
+                return Err(invalid(format!("mesh '{name}' has no POSITION")));
+            };
+            let what = format!("mesh '{name}' POSITION");
+            crate::accessor::check(&acc, &[(F32, Dimensions::Vec3)], buffer_len, &what)
+                .map_err(invalid)?;
+            if let Some(acc) = prim.indices() {
+                let what = format!("mesh '{name}' indices");
+                let allowed = [(U8, Scalar), (U16, Scalar), (U32, Scalar)];
+                crate::accessor::check(&acc, &allowed, buffer_len, &what).map_err(invalid)?;
             }
             let reader = prim.reader(get);
             let Some(positions) = reader.read_positions() else {
