@@ -37,6 +37,9 @@ pub struct Args {
 
 const SIM_FPS: f32 = 60.0;
 
+/// The most frames one GIF may hold (each is a whole picture in memory until encoded).
+const MAX_GIF_FRAMES: usize = 1_000;
+
 pub fn run(a: Args) -> Result<(), String> {
     let ext = a
         .out
@@ -87,6 +90,14 @@ pub fn run(a: Args) -> Result<(), String> {
             .map(|k| k * (n - 1) / (a.moments - 1))
             .collect()
     };
+    if picked.len() > MAX_GIF_FRAMES {
+        return Err(format!(
+            "the clip lasts {duration} s: {} frames at {} fps is more than the limit of \
+             {MAX_GIF_FRAMES} GIF frames; lower --gif-fps or write a .png",
+            picked.len(),
+            a.gif_fps
+        ));
+    }
     let mut figures = Vec::with_capacity(picked.len());
     play(&mut sim, clip, &times, &options, &mut |f| {
         for _ in picked.iter().filter(|&&p| p == f.index) {

@@ -1,6 +1,6 @@
 //! `tassel sample`: sampled (and blended) local and world transforms of every node.
 
-use crate::output::write_atomic;
+use crate::output::{write_atomic_with, JsonStream};
 use serde_json::json;
 use std::path::PathBuf;
 use tassel::anim::{BlendJob, BlendLayer, Playback, SamplingCursor, SamplingJob};
@@ -94,63 +94,63 @@ pub fn run(a: Args) -> Result<(), String> {
     let mut models = rest.clone();
     // Output in glTF node order.
     let order: Vec<usize> = (0..n).map(|node| model.node_to_joint[node]).collect();
-    let mut samples = Vec::with_capacity(times.len());
-    for &t in &times {
-        for (k, &(c, _)) in picks.iter().enumerate() {
-            sampled[k].copy_from_slice(&rest);
-            SamplingJob {
-                clip: &model.clips[c],
-                cursor: &mut cursors[k],
-                time: t,
-                playback: Playback::Clamp,
-                locals: &mut sampled[k],
-            }
-            .run()
-            .map_err(|e| e.to_string())?;
-        }
-        let layers: Vec<BlendLayer> = picks
-            .iter()
-            .zip(&sampled)
-            .map(|(p, l)| BlendLayer {
-                locals: l,
-                weight: p.1,
-                mask: None,
-            })
-            .collect();
-        BlendJob {
-            rest: &rest,
-            layers: &layers,
-            additive: &[],
-            out: &mut locals,
-        }
-        .run()
-        .map_err(|e| e.to_string())?;
-        LocalToModelJob {
-            skeleton: sk,
-            root: Transform::IDENTITY,
-            locals: &locals,
-            models: &mut models,
-        }
-        .run()
-        .map_err(|e| e.to_string())?;
-        samples.push(json!({
-            "t": t,
-            "local_t": order.iter().map(|&j| locals[j].translation.to_array()).collect::<Vec<_>>(),
-            "local_r": order.iter().map(|&j| locals[j].rotation.to_array()).collect::<Vec<_>>(),
-            "local_s": order.iter().map(|&j| locals[j].scale.to_array()).collect::<Vec<_>>(),
-            "world_pos": order.iter().map(|&j| models[j].translation.to_array()).collect::<Vec<_>>(),
-        }));
-    }
-    let doc = json!({
+    let head = json!({
         "clips": picks.iter().map(|p| json!({ "name": names[p.0], "index": p.0, "weight": p.1 })).collect::<Vec<_>>(),
         "times": times,
         "nodes": (0..n).map(|node| json!({ "node": node, "name": sk.name(model.node_to_joint[node]) })).collect::<Vec<_>>(),
-        "samples": samples,
     });
-    write_atomic(
-        &a.out,
-        &serde_json::to_vec(&doc).map_err(|e| e.to_string())?,
-    )?;
+    // Streamed time by time: a long, dense sampling never sits in memory.
+    write_atomic_with(&a.out, |out| {
+        let mut doc = JsonStream::begin(out, &head, "samples")?;
+        for &t in &times {
+            for (k, &(c, _)) in picks.iter().enumerate() {
+                sampled[k].copy_from_slice(&rest);
+                SamplingJob {
+                    clip: &model.clips[c],
+                    cursor: &mut cursors[k],
+                    time: t,
+                    playback: Playback::Clamp,
+                    locals: &mut sampled[k],
+                }
+                .run()
+                .map_err(|e| e.to_string())?;
+            }
+            let layers: Vec<BlendLayer> = picks
+                .iter()
+                .zip(&sampled)
+                .map(|(p, l)| BlendLayer {
+                    locals: l,
+                    weight: p.1,
+                    mask: None,
+                })
+                .collect();
+            BlendJob {
+                rest: &rest,
+                layers: &layers,
+                additive: &[],
+                out: &mut locals,
+            }
+            .run()
+            .map_err(|e| e.to_string())?;
+            LocalToModelJob {
+                skeleton: sk,
+                root: Transform::IDENTITY,
+                locals: &locals,
+                models: &mut models,
+            }
+            .run()
+            .map_err(|e| e.to_string())?;
+            let sample = json!({
+                "t": t,
+                "local_t": order.iter().map(|&j| locals[j].translation.to_array()).collect::<Vec<_>>(),
+                "local_r": order.iter().map(|&j| locals[j].rotation.to_array()).collect::<Vec<_>>(),
+                "local_s": order.iter().map(|&j| locals[j].scale.to_array()).collect::<Vec<_>>(),
+                "world_pos": order.iter().map(|&j| models[j].translation.to_array()).collect::<Vec<_>>(),
+            });
+            doc.push(&sample, &format!("time {t}"))?;
+        }
+        doc.end()
+    })?;
     say!(
         "wrote {} ({} nodes, {} times)",
         a.out.display(),

@@ -1,6 +1,6 @@
 //! `tassel simulate`: the scripted, machine-readable run (contract in README.md).
 
-use crate::output::write_atomic;
+use crate::output::{write_atomic_with, JsonStream};
 use glam::{Quat, Vec3};
 use serde_json::json;
 use std::path::PathBuf;
@@ -99,8 +99,27 @@ fn root_motion(a: &Args, t: f32) -> Transform {
     }
 }
 
+/// The largest rig file read (16 MiB: far beyond any real rig, far below any memory
+/// trouble).
+pub const MAX_RIG_BYTES: u64 = 16 << 20;
+
 pub fn read_rig(path: &PathBuf) -> Result<RigSettings, String> {
-    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    use std::io::Read;
+    let fail = |e: std::io::Error| format!("{}: {e}", path.display());
+    let file = std::fs::File::open(path).map_err(fail)?;
+    if !file.metadata().map_err(fail)?.is_file() {
+        return Err(format!("{}: not a regular file", path.display()));
+    }
+    let mut text = String::new();
+    file.take(MAX_RIG_BYTES + 1)
+        .read_to_string(&mut text)
+        .map_err(fail)?;
+    if text.len() as u64 > MAX_RIG_BYTES {
+        return Err(format!(
+            "{}: the rig file is larger than the limit of {MAX_RIG_BYTES} bytes",
+            path.display()
+        ));
+    }
     RigSettings::from_toml_str(&text).map_err(|e| format!("{}: {e}", path.display()))
 }
 
@@ -201,17 +220,6 @@ pub fn run(a: Args) -> Result<(), String> {
     sim.frame(&rest, Transform::IDENTITY, 0.0)
         .map_err(|e| e.to_string())?;
     let (initial_pos, initial_tails, _) = world(&sim, &Transform::IDENTITY);
-    let mut samples = Vec::with_capacity(a.frames);
-    for f in 1..=a.frames {
-        let t = f as f32 * a.dt;
-        let comp = root_motion(&a, t);
-        sim.frame(&rest, comp, a.dt).map_err(|e| e.to_string())?;
-        let (pos, tails, quats) = world(&sim, &comp);
-        samples.push(json!({
-            "frame": f, "t": t, "root_pos": comp.translation.to_array(),
-            "world_pos": pos, "tail_world_pos": tails, "world_quat": quats,
-        }));
-    }
     let joint_list: Vec<_> = joints
         .iter()
         .map(|&(j, tail)| {
@@ -222,13 +230,27 @@ pub fn run(a: Args) -> Result<(), String> {
             })
         })
         .collect();
-    let doc = json!({
+    let head = json!({
         "dt": a.dt, "frames": a.frames, "mode": mode_name, "joints": joint_list,
         "initial": { "world_pos": initial_pos, "tail_world_pos": initial_tails },
-        "samples": samples,
     });
-    let text = serde_json::to_vec(&doc).map_err(|e| e.to_string())?;
-    write_atomic(&a.out, &text)?;
+    // Streamed frame by frame: a million frames never sit in memory.
+    write_atomic_with(&a.out, |out| {
+        let mut doc = JsonStream::begin(out, &head, "samples")?;
+        for f in 1..=a.frames {
+            let t = f as f32 * a.dt;
+            let comp = root_motion(&a, t);
+            sim.frame(&rest, comp, a.dt)
+                .map_err(|e| format!("frame {f}: {e}"))?;
+            let (pos, tails, quats) = world(&sim, &comp);
+            let sample = json!({
+                "frame": f, "t": t, "root_pos": comp.translation.to_array(),
+                "world_pos": pos, "tail_world_pos": tails, "world_quat": quats,
+            });
+            doc.push(&sample, &format!("frame {f}"))?;
+        }
+        doc.end()
+    })?;
     say!(
         "wrote {} ({} joints, {} frames, mode {mode_name})",
         a.out.display(),
