@@ -1,0 +1,450 @@
+//! Fuzz target bodies. Each takes arbitrary bytes and panics only when Tassel breaks a
+//! promise: a panic inside Tassel itself, a non-finite number in an output pose, a bone
+//! farther from the character than its skeleton reaches. An input Tassel refuses with an
+//! error is a pass.
+//!
+//! `fuzz/run.sh TARGET SECONDS` runs one under libFuzzer (coverage-guided, stable Rust);
+//! `cargo test -p tassel-fuzz` replays the seed files and every input in
+//! `fuzz/regressions/` through the same functions.
+
+use arbitrary::Unstructured;
+use glam::{Quat, Vec3};
+use std::path::Path;
+use std::sync::OnceLock;
+use tassel::anim::{Playback, SamplingCursor, SamplingJob, StateMachine};
+use tassel::dynamics::vrm::{
+    VrmCollider, VrmColliderGroup, VrmJoint, VrmMode, VrmOptions, VrmShape, VrmSpring,
+    VrmSpringBones, VrmTail,
+};
+use tassel::dynamics::RigSettings;
+use tassel::{builtin, CharacterSim, Skeleton, SkeletonBuilder, Transform};
+
+/// A folder that does not exist: relative buffer URIs in fuzzed files resolve nowhere.
+const NO_FOLDER: &str = "/nonexistent/tassel-fuzz";
+
+/// glTF/GLB/VRM bytes → `tassel_gltf::load_slice`; a file that loads is then played: its
+/// first clip sampled through its VRM springs for a few frames (spec and fixed mode).
+pub fn gltf_import(data: &[u8]) {
+    let Ok(model) = tassel_gltf::load_slice(data, Some(Path::new(NO_FOLDER)), "<fuzz>") else {
+        return;
+    };
+    let springs = model
+        .vrm
+        .as_ref()
+        .map(|v| v.springs.clone())
+        .unwrap_or_default();
+    for mode in [VrmMode::Spec, VrmMode::Fixed] {
+        let options = VrmOptions {
+            mode,
+            ..VrmOptions::default()
+        };
+        let Ok(mut sim) = CharacterSim::with_vrm(
+            model.skeleton.clone(),
+            &RigSettings::default(),
+            &springs,
+            options,
+        ) else {
+            continue;
+        };
+        let mut locals = model.skeleton.rest().to_vec();
+        let mut cursor = model.clips.first().map(SamplingCursor::new);
+        for f in 0..4 {
+            let t = f as f32 / 30.0;
+            if let (Some(clip), Some(cursor)) = (model.clips.first(), cursor.as_mut()) {
+                let job = SamplingJob {
+                    clip,
+                    cursor,
+                    time: t,
+                    playback: Playback::Loop,
+                    locals: &mut locals,
+                };
+                if job.run().is_err() {
+                    return;
+                }
+            }
+            let component = Transform::from_translation(Vec3::new(0.3 * t, 0.0, 0.0));
+            if sim.frame(&locals, component, 1.0 / 30.0).is_ok() {
+                check_pose(&sim, &locals, "gltf_import");
+            }
+        }
+    }
+}
+
+/// Rig TOML text → `RigSettings::from_toml_str`; a rig that parses is compiled on the
+/// built-in character and run for a few frames of its walk.
+pub fn rig_toml(data: &[u8]) {
+    let Ok(text) = std::str::from_utf8(data) else {
+        return;
+    };
+    let Ok(rig) = RigSettings::from_toml_str(text) else {
+        return;
+    };
+    run_rig(&rig, &mut Unstructured::new(&[]), 6);
+}
+
+/// State-machine TOML text → `StateMachine::from_toml_str` against the built-in clips;
+/// a machine that compiles is updated with changing parameters.
+pub fn state_machine_toml(data: &[u8]) {
+    let Ok(text) = std::str::from_utf8(data) else {
+        return;
+    };
+    let c = character();
+    let names: Vec<&str> = c.clips.iter().map(|c| c.name.as_str()).collect();
+    let durations: Vec<f32> = c.clips.iter().map(|c| c.duration).collect();
+    let Ok(machine) = StateMachine::from_toml_str(text, &names, &durations) else {
+        return;
+    };
+    let mut state = machine.new_state();
+    let mut plan = Default::default();
+    let params = text.len() % 7;
+    for f in 0..32 {
+        for p in 0..params {
+            state.set(p, (f * (p + 1)) as f32 * 0.1);
+        }
+        machine.update(&mut state, 1.0 / 30.0, &mut plan);
+        let total: f32 = plan.layers.iter().map(|l| l.weight).sum();
+        assert!(
+            total.is_finite() && plan.layers.iter().all(|l| l.time.is_finite()),
+            "state machine: non-finite plan {plan:?}"
+        );
+    }
+}
+
+/// Arbitrary settings and motion. The first bytes pick the subject: the built-in
+/// character with its rig's numbers, names and switches perturbed (its chains, springs,
+/// skirt cloth, rope, or all of them), or a small chain of bones (zero-length ones included) with VRM
+/// springs and colliders on top of its bones. Frames then come with hitches (dt from 0 to
+/// far beyond a second), teleports, NaN and infinite inputs.
+pub fn simulation(data: &[u8]) {
+    let mut u = Unstructured::new(data);
+    let frames = u.int_in_range(1..=16).unwrap_or(8);
+    if u.ratio(1, 3).unwrap_or(false) {
+        if let Some((skeleton, springs, options)) = vrm_subject(&mut u) {
+            if let Ok(mut sim) =
+                CharacterSim::with_vrm(skeleton, &RigSettings::default(), &springs, options)
+            {
+                drive(&mut sim, &mut u, frames, "simulation (VRM)");
+            }
+        }
+        return;
+    }
+    // One kind of solver per input keeps an execution short (the cloth alone is most of
+    // the character's cost); the colliders stay.
+    let full = &character().rig;
+    let mut rig = RigSettings {
+        colliders: full.colliders.clone(),
+        ..RigSettings::default()
+    };
+    match u.int_in_range(0..=4).unwrap_or(0) {
+        0 => rig.chains = full.chains.clone(),
+        1 => rig.springs = full.springs.clone(),
+        2 => rig.cloths = full.cloths.clone(),
+        3 => rig.ropes = full.ropes.clone(),
+        _ => rig = full.clone(),
+    }
+    if perturb_rig(&mut rig, &mut u).is_some() {
+        run_rig(&rig, &mut u, frames);
+    }
+}
+
+fn character() -> &'static builtin::Character {
+    static CHARACTER: OnceLock<builtin::Character> = OnceLock::new();
+    CHARACTER.get_or_init(builtin::character)
+}
+
+fn run_rig(rig: &RigSettings, u: &mut Unstructured, frames: u32) {
+    let c = character();
+    let Ok(mut sim) = CharacterSim::new(c.skeleton.clone(), rig) else {
+        return;
+    };
+    drive(&mut sim, u, frames, "rig");
+}
+
+/// Runs `frames` frames of the walk with motion drawn from `u`; after every frame the
+/// simulator accepted, the pose must be finite and within the skeleton's reach.
+fn drive(sim: &mut CharacterSim, u: &mut Unstructured, frames: u32, what: &str) {
+    let skeleton = sim.skeleton().clone();
+    let clip = character()
+        .clips
+        .get(1)
+        .filter(|_| skeleton.len() == character().skeleton.len());
+    let mut cursor = clip.map(SamplingCursor::new);
+    let mut locals = skeleton.rest().to_vec();
+    let mut position = Vec3::ZERO;
+    let mut yaw = 0.0f32;
+    let mut t = 0.0f32;
+    for _ in 0..frames {
+        let dt = match u.int_in_range(0..=9).unwrap_or(0) {
+            0..=4 => 1.0 / 60.0,
+            5 => 0.0,
+            6 => unit(u),
+            7 => 1.0 / 144.0,
+            8 => special(u),
+            _ => unit(u) * 30.0,
+        };
+        if dt.is_finite() && dt > 0.0 {
+            t += dt.min(10.0);
+        }
+        match u.int_in_range(0..=12).unwrap_or(0) {
+            0 => position += Vec3::new(1000.0, 0.0, 0.0),
+            1 => position = Vec3::splat(special(u)),
+            2 => yaw += std::f32::consts::PI * unit(u),
+            3 => yaw = special(u),
+            _ => position += Vec3::new(0.05, 0.0, 0.02) * (unit(u) - 0.5),
+        }
+        if let (Some(clip), Some(cursor)) = (clip, cursor.as_mut()) {
+            let job = SamplingJob {
+                clip,
+                cursor,
+                time: t,
+                playback: Playback::Loop,
+                locals: &mut locals,
+            };
+            if job.run().is_err() {
+                return;
+            }
+        }
+        if u.ratio(1, 8).unwrap_or(false) {
+            // A bad animated joint: zero length, NaN or a wild rotation.
+            let j = u.choose_index(locals.len()).unwrap_or(0);
+            match u.int_in_range(0..=2).unwrap_or(0) {
+                0 => locals[j].translation = Vec3::ZERO,
+                1 => locals[j].rotation = Quat::from_xyzw(special(u), 0.0, 0.0, 1.0),
+                _ => locals[j].translation = Vec3::splat(special(u)),
+            }
+        }
+        let component = Transform::from_translation_rotation(position, Quat::from_rotation_y(yaw));
+        if sim.frame(&locals, component, dt).is_ok() {
+            check_pose(sim, &locals, what);
+        }
+        if !position.is_finite() || position.abs().max_element() > 1e5 {
+            position = Vec3::ZERO;
+        }
+        if !yaw.is_finite() {
+            yaw = 0.0;
+        }
+        locals.copy_from_slice(skeleton.rest());
+    }
+}
+
+/// The pose after an accepted frame: finite, and no joint farther from its root than the
+/// animated bone lengths above it add up to (rotations never lengthen a bone; a spring may
+/// move a joint, so 100 units are allowed on top).
+fn check_pose(sim: &CharacterSim, animated: &[Transform], what: &str) {
+    let pose = sim.pose();
+    let skeleton = sim.skeleton();
+    let animated_models = sim.animated_models();
+    let mut reach = vec![0.0f32; skeleton.len()];
+    for j in 0..skeleton.len() {
+        let l = &pose.locals[j];
+        let m = &pose.models[j];
+        assert!(
+            l.is_finite() && m.is_finite(),
+            "{what}: joint '{}' is not finite: local {l:?}, model {m:?} (animated {:?})",
+            skeleton.name(j),
+            animated[j]
+        );
+        if let Some(p) = skeleton.parent(j) {
+            reach[j] = reach[p]
+                + (animated_models[j].translation - animated_models[p].translation).length();
+            let from_root = (m.translation - root_of(skeleton, &pose.models, j)).length();
+            assert!(
+                from_root <= reach[j] * 1.001 + 100.0,
+                "{what}: joint '{}' is {from_root} from its root, its bones reach {}",
+                skeleton.name(j),
+                reach[j]
+            );
+        }
+    }
+}
+
+fn root_of(skeleton: &Skeleton, models: &[Transform], mut j: usize) -> Vec3 {
+    while let Some(p) = skeleton.parent(j) {
+        j = p;
+    }
+    models[j].translation
+}
+
+/// A number in 0..1.
+fn unit(u: &mut Unstructured) -> f32 {
+    u.int_in_range(0..=u16::MAX).unwrap_or(0) as f32 / u16::MAX as f32
+}
+
+/// A number a hostile caller might send.
+fn special(u: &mut Unstructured) -> f32 {
+    *u.choose(&[
+        0.0,
+        -1.0,
+        1e-30,
+        1e6,
+        -1e6,
+        1e20,
+        f32::MAX,
+        f32::NAN,
+        f32::INFINITY,
+        f32::NEG_INFINITY,
+    ])
+    .unwrap_or(&0.0)
+}
+
+/// A replacement for a setting whose default is `x`: mostly near it, sometimes extreme.
+fn number(u: &mut Unstructured, x: f64) -> f64 {
+    match u.int_in_range(0..=7).unwrap_or(0) {
+        0..=3 => x * (2.0 * unit(u) as f64),
+        4 => x + 10.0 * (unit(u) as f64 - 0.5),
+        5 => -x,
+        _ => special(u) as f64,
+    }
+}
+
+/// Changes the rig's numbers, integers, switches and names at random (through its TOML
+/// form, so the parser and validation see the result). `None` when the result does not
+/// parse or validate — which is the point of many inputs, and a pass.
+fn perturb_rig(rig: &mut RigSettings, u: &mut Unstructured) -> Option<()> {
+    let mut value = toml::Value::try_from(&*rig).ok()?;
+    let rate = u.int_in_range(2..=24).unwrap_or(8);
+    perturb_value(&mut value, u, rate);
+    let text = toml::to_string(&value).ok()?;
+    *rig = RigSettings::from_toml_str(&text).ok()?;
+    Some(())
+}
+
+fn perturb_value(v: &mut toml::Value, u: &mut Unstructured, rate: u32) {
+    let hit = |u: &mut Unstructured| u.ratio(1, rate).unwrap_or(false);
+    match v {
+        toml::Value::Float(x) => {
+            if hit(u) {
+                *x = number(u, *x);
+            }
+        }
+        toml::Value::Integer(i) => {
+            if hit(u) {
+                *i = *u
+                    .choose(&[0, 1, 2, 64, 65, 1_000, 100_000, i64::from(u32::MAX)])
+                    .unwrap_or(&0);
+            }
+        }
+        toml::Value::Boolean(b) => {
+            if hit(u) {
+                *b = !*b;
+            }
+        }
+        toml::Value::String(s) => {
+            if hit(u) {
+                s.push('x');
+            }
+        }
+        toml::Value::Array(a) => {
+            for x in a.iter_mut() {
+                perturb_value(x, u, rate);
+            }
+            if hit(u) && !a.is_empty() {
+                let i = u.choose_index(a.len()).unwrap_or(0);
+                let copy = a[i].clone();
+                a.push(copy);
+            }
+        }
+        toml::Value::Table(t) => {
+            for (_, x) in t.iter_mut() {
+                perturb_value(x, u, rate);
+            }
+        }
+        toml::Value::Datetime(_) => {}
+    }
+}
+
+/// A chain of 2..=8 bones under a root (some of zero length), one VRM spring over it with
+/// drawn parameters, and 0..=4 colliders of every shape on drawn bones.
+fn vrm_subject(u: &mut Unstructured) -> Option<(Skeleton, VrmSpringBones, VrmOptions)> {
+    let n = u.int_in_range(2..=8).ok()?;
+    let mut b = SkeletonBuilder::new();
+    let mut parent = b.add("root", None, Transform::IDENTITY);
+    for i in 0..n {
+        let offset = if u.ratio(1, 6).ok()? {
+            Vec3::ZERO
+        } else {
+            Vec3::new(unit(u) - 0.5, -0.1 - unit(u) * 0.2, unit(u) - 0.5) * 0.3
+        };
+        parent = b.add(
+            format!("b{i}"),
+            Some(parent),
+            Transform::from_translation(offset),
+        );
+    }
+    let (skeleton, _) = b.build().ok()?;
+    let mut springs = VrmSpringBones::default();
+    let colliders = u.int_in_range(0..=4).ok()?;
+    for _ in 0..colliders {
+        let joint = u.int_in_range(0..=n).ok()?;
+        let offset = Vec3::new(unit(u) - 0.5, unit(u) - 0.5, unit(u) - 0.5) * 0.2;
+        let radius = if u.ratio(1, 8).ok()? {
+            special(u)
+        } else {
+            unit(u) * 0.1
+        };
+        let inside = u.ratio(1, 4).ok()?;
+        let shape = match u.int_in_range(0..=2).ok()? {
+            0 => VrmShape::Sphere {
+                offset,
+                radius,
+                inside,
+            },
+            1 => VrmShape::Capsule {
+                offset,
+                tail: offset + Vec3::new(0.0, unit(u) * 0.2, 0.0),
+                radius,
+                inside,
+            },
+            _ => VrmShape::Plane {
+                offset,
+                normal: Vec3::new(unit(u) - 0.5, unit(u), unit(u) - 0.5),
+            },
+        };
+        springs.colliders.push(VrmCollider { joint, shape });
+    }
+    springs.collider_groups.push(VrmColliderGroup {
+        name: "all".into(),
+        colliders: (0..springs.colliders.len()).collect(),
+    });
+    let mut joints = Vec::new();
+    for j in 1..=n {
+        let tail = if j < n {
+            VrmTail::Joint(j + 1)
+        } else {
+            VrmTail::Local(Vec3::new(0.0, -0.07, 0.0))
+        };
+        let extreme = u.ratio(1, 10).ok()?;
+        let mut value = |scale: f32| {
+            if extreme {
+                special(u)
+            } else {
+                unit(u) * scale
+            }
+        };
+        joints.push(VrmJoint {
+            joint: j,
+            tail,
+            hit_radius: value(0.1),
+            stiffness: value(4.0),
+            gravity_power: value(2.0),
+            gravity_dir: Vec3::NEG_Y,
+            drag_force: value(1.0),
+        });
+    }
+    springs.springs.push(VrmSpring {
+        name: "fuzz".into(),
+        joints,
+        collider_groups: vec![0],
+        center: None,
+    });
+    let options = VrmOptions {
+        mode: if u.ratio(1, 2).ok()? {
+            VrmMode::Spec
+        } else {
+            VrmMode::Fixed
+        },
+        teleport_distance: if u.ratio(1, 2).ok()? { 0.0 } else { 1.0 },
+        ..VrmOptions::default()
+    };
+    Some((skeleton, springs, options))
+}

@@ -1,0 +1,88 @@
+//! Replays, through the fuzz targets' own functions: every input in
+//! `fuzz/regressions/<target>/` (the inputs that once found a bug, and hand-made hostile
+//! ones), every file the local corpus `fuzz/corpus/<target>/` holds if a fuzz run left
+//! one, and the seed files the corpus script starts from (`../shared/testdata`, the
+//! example rigs, the built-in state machine). A panic here is a bug the fuzzers found.
+
+use std::path::{Path, PathBuf};
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).to_path_buf()
+}
+
+/// Every file directly in `dir` (none if it does not exist), sorted.
+fn files(dir: &Path) -> Vec<PathBuf> {
+    let mut out: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map(|d| d.filter_map(|e| e.ok().map(|e| e.path())).collect())
+        .unwrap_or_default();
+    out.retain(|p| p.is_file());
+    out.sort();
+    out
+}
+
+fn replay(target: &str, run: fn(&[u8]), seeds: &[PathBuf]) -> usize {
+    let mut inputs = files(&root().join("regressions").join(target));
+    inputs.extend(files(&root().join("corpus").join(target)));
+    inputs.extend(seeds.iter().cloned());
+    for path in &inputs {
+        let data = std::fs::read(path).unwrap();
+        let name = path.display().to_string();
+        let result = std::panic::catch_unwind(|| run(&data));
+        assert!(result.is_ok(), "{target}: {name} panicked");
+    }
+    println!("{target}: {} inputs replayed", inputs.len());
+    inputs.len()
+}
+
+fn testdata() -> Option<PathBuf> {
+    let dir = root().join("../../shared/testdata");
+    if dir.is_dir() {
+        return Some(dir);
+    }
+    assert!(
+        std::env::var_os("TASSEL_REQUIRE_TESTDATA").is_none(),
+        "../shared/testdata is missing and TASSEL_REQUIRE_TESTDATA is set"
+    );
+    println!("SKIPPED the testdata seeds: ../shared/testdata is missing");
+    None
+}
+
+#[test]
+fn gltf_import_replays() {
+    let mut seeds = Vec::new();
+    if let Some(dir) = testdata() {
+        seeds.extend(files(&dir.join("gltf")));
+        seeds.extend(files(&dir.join("vrm")));
+    }
+    let n = replay("gltf_import", tassel_fuzz::gltf_import, &seeds);
+    assert!(
+        n >= 8,
+        "only {n} inputs: the regression folder should hold the hostile files"
+    );
+}
+
+#[test]
+fn rig_toml_replays() {
+    let seeds = files(&root().join("../examples/rigs"));
+    let n = replay("rig_toml", tassel_fuzz::rig_toml, &seeds);
+    assert!(n >= 2, "only {n} inputs");
+}
+
+#[test]
+fn state_machine_toml_replays() {
+    let n = replay("state_machine_toml", tassel_fuzz::state_machine_toml, &[]);
+    tassel_fuzz::state_machine_toml(tassel::anim::StateMachine::LOCOMOTION.as_bytes());
+    assert!(n >= 1, "only {n} inputs");
+}
+
+#[test]
+fn simulation_replays() {
+    let n = replay("simulation", tassel_fuzz::simulation, &[]);
+    // Plus a fixed sweep of byte patterns, so the target runs even on a fresh clone.
+    for seed in 0u64..200 {
+        let mut rng = tassel::rng::SplitMix64::new(seed);
+        let data: Vec<u8> = (0..512).map(|_| rng.next_u64() as u8).collect();
+        tassel_fuzz::simulation(&data);
+    }
+    assert!(n >= 1, "only {n} inputs");
+}
