@@ -60,7 +60,23 @@ struct One {
     velocity: Vec3,
     remaining: f32,
     prev_target: Vec3,
+    /// The target of the last step (where `location` is measured from).
+    step_target: Vec3,
+    /// How fast the spring's frame (the owner's velocity it is carried with) moved
+    /// relative to the target over the last frame with steps: the owner velocity times its
+    /// scale, less the target's velocity.
+    drift: Vec3,
     initialized: bool,
+}
+
+impl One {
+    /// The displacement from the target at the frame's end: the last step's deviation,
+    /// moved on by the carried-over time at the velocity relative to the target. Measured
+    /// from the target, never an absolute position, so the output does not lag a moving
+    /// target by the carried-over time (a 1 km teleport once left a bone 485 m behind).
+    fn deviation(&self) -> Vec3 {
+        self.location - self.step_target + (self.velocity + self.drift) * self.remaining
+    }
 }
 
 /// Per-character spring state: each bone's world location and velocity, and the time
@@ -90,8 +106,7 @@ impl SpringState {
 
     /// The world-space displacement of spring `i` from its target after the last frame.
     pub fn displacement(&self, i: usize) -> Vec3 {
-        let s = &self.springs[i];
-        s.location + s.velocity * s.remaining - s.prev_target
+        self.springs[i].deviation()
     }
 
     /// Releases spring `i` from `offset` (world space, metres) away from its last target,
@@ -100,7 +115,9 @@ impl SpringState {
         if let Some(s) = self.springs.get_mut(i) {
             if s.initialized && offset.is_finite() {
                 s.location = s.prev_target + offset;
+                s.step_target = s.prev_target;
                 s.velocity = Vec3::ZERO;
+                s.drift = Vec3::ZERO;
                 s.remaining = 0.0;
             }
         }
@@ -172,6 +189,8 @@ impl SpringJob<'_> {
                     velocity: Vec3::ZERO,
                     remaining: 0.0,
                     prev_target: target,
+                    step_target: target,
+                    drift: Vec3::ZERO,
                     initialized: true,
                 };
             }
@@ -184,6 +203,10 @@ impl SpringJob<'_> {
                 steps = s.max_steps_per_frame;
             }
             let start_target = st.prev_target;
+            if steps > 0 && self.dt > 0.0 {
+                st.drift =
+                    owner_velocity * s.owner_velocity_scale - (target - start_target) / self.dt;
+            }
             for k in 1..=steps {
                 // Where this step ends between last frame (0) and this one (1): the target
                 // moves linearly across the frame's steps.
@@ -193,6 +216,7 @@ impl SpringJob<'_> {
                     1.0
                 };
                 let tgt = start_target.lerp(target, w);
+                st.step_target = tgt;
                 st.location += owner_velocity * (h * s.owner_velocity_scale);
                 if s.error_reset_threshold > 0.0
                     && (tgt - st.location).length_squared() > s.error_reset_threshold.powi(2)
@@ -222,9 +246,13 @@ impl SpringJob<'_> {
             }
             st.remaining -= steps as f32 * h;
             st.prev_target = target;
-            // Output at this frame's time: the last step moved on by the carried-over time.
-            let out_ws = st.location + st.velocity * st.remaining;
-            let mut disp_cs = inv_rot * (out_ws - target);
+            // Output at this frame's time: this frame's target plus the last step's
+            // deviation moved on by the carried-over time, within the displacement limit.
+            let mut disp_ws = st.deviation();
+            if s.limit_displacement > 0.0 && disp_ws.length() > s.limit_displacement {
+                disp_ws = disp_ws.normalize() * s.limit_displacement;
+            }
+            let mut disp_cs = inv_rot * disp_ws;
             for (axis, on) in s.translate.iter().enumerate() {
                 if !on {
                     disp_cs[axis] = 0.0;
