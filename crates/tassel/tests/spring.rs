@@ -262,5 +262,46 @@ fn a_carried_bone_never_lags_its_moving_owner() {
             "{hz} Hz after a 1 km teleport: {}",
             p.translation
         );
+        // A move in a frame of 1e-30 s is no infinite velocity.
+        for dt in [1e-30, 1e-30, 1.0 / hz] {
+            x += 0.5;
+            let p = run.frame(
+                Transform::from_translation(Vec3::new(x, 0.0, 0.0)),
+                rest,
+                dt,
+            );
+            assert!(
+                p.translation.is_finite() && (p.translation - rest).length() < 0.05,
+                "{hz} Hz, dt {dt}: {}",
+                p.translation
+            );
+        }
+    }
+}
+
+/// Settings at the edge of f32 (a stiffness of 3.4e38 passes validation: it is finite)
+/// overflow the integration; the bone then starts again at its target instead of
+/// writing NaN (found by the simulation fuzzer).
+#[test]
+fn an_overflowing_spring_restarts_at_its_target() {
+    let rest = Vec3::new(0.0, 0.2, 0.0);
+    let mut run = Run::new(SpringSettings {
+        name: "s".into(),
+        bone: "bob".into(),
+        use_rotation: false,
+        stiffness: f32::MAX,
+        limit_displacement: 0.0,
+        error_reset_threshold: 0.0,
+        ..Default::default()
+    });
+    run.frame(Transform::IDENTITY, rest, 0.0);
+    for f in 1..=30 {
+        let comp = Transform::from_translation(Vec3::new(0.1 * (f as f32).sin(), 0.0, 0.0));
+        let p = run.frame(
+            comp,
+            rest + Vec3::new(0.0, 0.01 * f as f32, 0.0),
+            1.0 / 50.0,
+        );
+        assert!(p.translation.is_finite(), "frame {f}: {}", p.translation);
     }
 }

@@ -173,8 +173,11 @@ impl SpringJob<'_> {
     pub fn run(self) -> Result<()> {
         self.validate()?;
         let comp = self.component;
+        // A velocity is only measured over a real step of time: a frame shorter than the
+        // shortest time step (say 1e-30 s) would turn any motion into an infinite speed.
+        let measurable = self.dt >= crate::limits::MIN_TIME_STEP;
         let owner_velocity = match self.state.prev_component {
-            Some(p) if self.dt > 0.0 => (comp.translation - p.translation) / self.dt,
+            Some(p) if measurable => (comp.translation - p.translation) / self.dt,
             _ => Vec3::ZERO,
         };
         self.state.prev_component = Some(comp);
@@ -203,7 +206,7 @@ impl SpringJob<'_> {
                 steps = s.max_steps_per_frame;
             }
             let start_target = st.prev_target;
-            if steps > 0 && self.dt > 0.0 {
+            if steps > 0 && measurable {
                 st.drift =
                     owner_velocity * s.owner_velocity_scale - (target - start_target) / self.dt;
             }
@@ -249,6 +252,11 @@ impl SpringJob<'_> {
             // Output at this frame's time: this frame's target plus the last step's
             // deviation moved on by the carried-over time, within the displacement limit.
             let mut disp_ws = st.deviation();
+            if !disp_ws.is_finite() {
+                // Beyond f32 (a hostile motion): start again at the target.
+                st.initialized = false;
+                disp_ws = Vec3::ZERO;
+            }
             if s.limit_displacement > 0.0 && disp_ws.length() > s.limit_displacement {
                 disp_ws = disp_ws.normalize() * s.limit_displacement;
             }
