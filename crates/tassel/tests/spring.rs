@@ -279,29 +279,39 @@ fn a_carried_bone_never_lags_its_moving_owner() {
     }
 }
 
-/// Settings at the edge of f32 (a stiffness of 3.4e38 passes validation: it is finite)
-/// overflow the integration; the bone then starts again at its target instead of
-/// writing NaN (found by the simulation fuzzer).
+/// The stability check against the closed form: an undamped spring integrated by
+/// kick-drift-kick is stable exactly while ω·h ≤ 2 (k·h² ≤ 4), and growth is 1 there;
+/// damping alone, while b·h ≤ 4. A stiffness of 3.4e38 (finite, so it passed the old
+/// checks) overflowed to NaN, and a merely too-high one ran away to 4e17 m: both found by
+/// the simulation fuzzer, both refused now with a message naming the spring.
 #[test]
-fn an_overflowing_spring_restarts_at_its_target() {
-    let rest = Vec3::new(0.0, 0.2, 0.0);
-    let mut run = Run::new(SpringSettings {
+fn unstable_settings_are_refused_at_the_stability_edge() {
+    let s = |k: f32, b: f32, h: f32| SpringSettings {
         name: "s".into(),
         bone: "bob".into(),
-        use_rotation: false,
-        stiffness: f32::MAX,
-        limit_displacement: 0.0,
-        error_reset_threshold: 0.0,
+        stiffness: k,
+        damping: b,
+        fixed_time_step: h,
+        cutoff_damping: 1e9,
         ..Default::default()
-    });
-    run.frame(Transform::IDENTITY, rest, 0.0);
-    for f in 1..=30 {
-        let comp = Transform::from_translation(Vec3::new(0.1 * (f as f32).sin(), 0.0, 0.0));
-        let p = run.frame(
-            comp,
-            rest + Vec3::new(0.0, 0.01 * f as f32, 0.0),
-            1.0 / 50.0,
-        );
-        assert!(p.translation.is_finite(), "frame {f}: {}", p.translation);
-    }
+    };
+    let h = 0.01;
+    assert!((s(3.99 / (h * h), 0.0, h).step_growth() - 1.0).abs() < 1e-6);
+    assert!(s(3.99 / (h * h), 0.0, h).validate().is_ok());
+    let e = s(4.01 / (h * h), 0.0, h)
+        .validate()
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("unstable") && e.contains("spring 's'"), "{e}");
+    assert!(s(f32::MAX, 4.0, 1.0 / 120.0).validate().is_err());
+    // Damping of b·h = 4 makes c = −1: the velocity flips sign and grows.
+    assert!(s(0.0, 4.01 / h, h).validate().is_err());
+    assert!(s(0.0, 3.99 / h, h).validate().is_ok());
+    // The defaults and the built-in character's chest springs are far from the edge.
+    assert!(SpringSettings::default().step_growth() < 1.0);
+    let e = tassel::CharacterSim::new(
+        tassel::builtin::character().skeleton,
+        &tassel::builtin::character().rig,
+    );
+    assert!(e.is_ok());
 }

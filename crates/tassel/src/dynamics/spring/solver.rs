@@ -253,7 +253,9 @@ impl SpringJob<'_> {
             // deviation moved on by the carried-over time, within the displacement limit.
             let mut disp_ws = st.deviation();
             if !disp_ws.is_finite() {
-                // Beyond f32 (a hostile motion): start again at the target.
+                // Beyond f32: start again at the target. Validation refuses the settings
+                // that overflow (see `SpringSettings::step_growth`); this stays as the
+                // last guard so that no NaN is ever written.
                 st.initialized = false;
                 disp_ws = Vec3::ZERO;
             }
