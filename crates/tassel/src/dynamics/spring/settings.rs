@@ -106,6 +106,21 @@ impl SpringSettings {
                 self.max_steps_per_frame
             ));
         }
+        for (p, v) in [
+            ("error_reset_threshold", self.error_reset_threshold),
+            ("limit_displacement", self.limit_displacement),
+        ] {
+            if v > 1000.0 {
+                return bad(format!("{p} is {v}; it must be at most 1000"));
+            }
+        }
+        if self.error_reset_threshold == 0.0 && self.limit_displacement == 0.0 {
+            return bad(
+                "error_reset_threshold and limit_displacement are both 0 (off): nothing \
+                 would bound the bone after a teleport; set one of them"
+                    .into(),
+            );
+        }
         let growth = self.step_growth();
         if growth > 1.0 + 1e-9 {
             return bad(format!(

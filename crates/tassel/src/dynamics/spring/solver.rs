@@ -62,6 +62,9 @@ struct One {
     prev_target: Vec3,
     /// The target of the last step (where `location` is measured from).
     step_target: Vec3,
+    /// The owner's (character's) position at the last step's time: each step carries the
+    /// bone by the owner's motion since then.
+    step_owner: Vec3,
     /// How fast the spring's frame (the owner's velocity it is carried with) moved
     /// relative to the target over the last frame with steps: the owner velocity times its
     /// scale, less the target's velocity.
@@ -176,10 +179,10 @@ impl SpringJob<'_> {
         // A velocity is only measured over a real step of time: a frame shorter than the
         // shortest time step (say 1e-30 s) would turn any motion into an infinite speed.
         let measurable = self.dt >= crate::limits::MIN_TIME_STEP;
-        let owner_velocity = match self.state.prev_component {
-            Some(p) if measurable => (comp.translation - p.translation) / self.dt,
-            _ => Vec3::ZERO,
-        };
+        let prev_owner = self
+            .state
+            .prev_component
+            .map_or(comp.translation, |p| p.translation);
         self.state.prev_component = Some(comp);
         let inv_rot = comp.rotation.inverse();
         for (i, (s, j)) in self.rig.springs.iter().enumerate() {
@@ -193,6 +196,7 @@ impl SpringJob<'_> {
                     remaining: 0.0,
                     prev_target: target,
                     step_target: target,
+                    step_owner: comp.translation,
                     drift: Vec3::ZERO,
                     initialized: true,
                 };
@@ -207,8 +211,9 @@ impl SpringJob<'_> {
             }
             let start_target = st.prev_target;
             if steps > 0 && measurable {
+                let owner_moved = comp.translation - prev_owner;
                 st.drift =
-                    owner_velocity * s.owner_velocity_scale - (target - start_target) / self.dt;
+                    (owner_moved * s.owner_velocity_scale - (target - start_target)) / self.dt;
             }
             for k in 1..=steps {
                 // Where this step ends between last frame (0) and this one (1): the target
@@ -220,7 +225,12 @@ impl SpringJob<'_> {
                 };
                 let tgt = start_target.lerp(target, w);
                 st.step_target = tgt;
-                st.location += owner_velocity * (h * s.owner_velocity_scale);
+                // Carried by the owner's motion over exactly this step (Unreal adds owner
+                // velocity × step; measured as a displacement it stays consistent with the
+                // target when a step spans two frames or a frame carries a teleport).
+                let owner = prev_owner.lerp(comp.translation, w);
+                st.location += (owner - st.step_owner) * s.owner_velocity_scale;
+                st.step_owner = owner;
                 if s.error_reset_threshold > 0.0
                     && (tgt - st.location).length_squared() > s.error_reset_threshold.powi(2)
                 {
