@@ -228,13 +228,17 @@ fn drive(sim: &mut CharacterSim, u: &mut Unstructured, frames: u32, what: &str) 
 }
 
 /// The pose after an accepted frame: finite, and no joint farther from its root than the
-/// animated bone lengths above it add up to (rotations never lengthen a bone; a spring may
-/// move a joint, so 100 units are allowed on top).
+/// animated bone lengths above it add up to (rotations never lengthen a bone), plus, for
+/// a joint at or below a spring controller's bone (which moves), twice the largest
+/// displacement a spring may reach (its limits are at most 1000 units).
 fn check_pose(sim: &CharacterSim, animated: &[Transform], what: &str) {
     let pose = sim.pose();
     let skeleton = sim.skeleton();
     let animated_models = sim.animated_models();
     let mut reach = vec![0.0f32; skeleton.len()];
+    for i in 0..sim.springs().len() {
+        reach[sim.springs().joint(i)] = 2000.0;
+    }
     for j in 0..skeleton.len() {
         let l = &pose.locals[j];
         let m = &pose.models[j];
@@ -245,11 +249,11 @@ fn check_pose(sim: &CharacterSim, animated: &[Transform], what: &str) {
             animated[j]
         );
         if let Some(p) = skeleton.parent(j) {
-            reach[j] = reach[p]
+            reach[j] += reach[p]
                 + (animated_models[j].translation - animated_models[p].translation).length();
             let from_root = (m.translation - root_of(skeleton, &pose.models, j)).length();
             assert!(
-                from_root <= reach[j] * 1.001 + 100.0,
+                from_root <= reach[j] * 1.001 + 1e-3,
                 "{what}: joint '{}' is {from_root} from its root, its bones reach {}",
                 skeleton.name(j),
                 reach[j]
