@@ -239,6 +239,7 @@ fn check_pose(sim: &CharacterSim, animated: &[Transform], what: &str) {
     for i in 0..sim.springs().len() {
         reach[sim.springs().joint(i)] = 2000.0;
     }
+    let mut depth = vec![0usize; skeleton.len()];
     for j in 0..skeleton.len() {
         let l = &pose.locals[j];
         let m = &pose.models[j];
@@ -251,9 +252,18 @@ fn check_pose(sim: &CharacterSim, animated: &[Transform], what: &str) {
         if let Some(p) = skeleton.parent(j) {
             reach[j] += reach[p]
                 + (animated_models[j].translation - animated_models[p].translation).length();
-            let from_root = (m.translation - root_of(skeleton, &pose.models, j)).length();
+            depth[j] = depth[p] + 1;
+            let root = root_of(skeleton, &pose.models, j);
+            let from_root = (m.translation - root).length();
+            // f32 rounding: at 1e6 units (the coordinate limit) one ulp is 6 cm, and every
+            // level of the hierarchy can add one.
+            let magnitude = root
+                .abs()
+                .max_element()
+                .max(m.translation.abs().max_element());
+            let rounding = 1e-6 * magnitude * (depth[j] + 1) as f32;
             assert!(
-                from_root <= reach[j] * 1.001 + 1e-3,
+                from_root <= reach[j] * 1.001 + 1e-3 + rounding,
                 "{what}: joint '{}' is {from_root} from its root, its bones reach {}",
                 skeleton.name(j),
                 reach[j]
