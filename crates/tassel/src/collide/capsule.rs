@@ -3,29 +3,63 @@
 use crate::math::{closest_params_segment_segment, closest_point_on_segment, normalize_or};
 use glam::Vec3;
 
-/// Pushes `p` out of the capsule `a`–`b` with `limit` = capsule radius + point radius. A
-/// point whose step (`prev` → `p`) passed through the capsule is returned to the side it
-/// came from.
+/// Pushes `p` out of the capsule `a`–`b` with `limit` = capsule radius + point radius.
+///
+/// As [`crate::collide::push_out_of_sphere`]: a point inside is pushed out radially; a
+/// step that entered the capsule from outside by more than a rounding tolerance (also one
+/// that passed right through) stops where it met the surface and keeps the tangential
+/// part of the rest of its step, so a point sliding along the capsule slides on.
 pub fn push_out_of_capsule(p: Vec3, prev: Vec3, a: Vec3, b: Vec3, limit: f32) -> Vec3 {
+    let tol = crate::collide::contact_tolerance(limit);
+    let inner = (limit - tol).max(0.0);
+    let dist = |q: Vec3| (q - closest_point_on_segment(q, a, b)).length();
+    let prev_fallback = || {
+        normalize_or(
+            prev - closest_point_on_segment(prev, a, b),
+            (b - a).any_orthonormal_vector(),
+        )
+    };
+    if dist(prev) >= inner {
+        let (s, t) = closest_params_segment_segment(prev, p, a, b);
+        let on_path = prev + (p - prev) * s;
+        let on_axis = a + (b - a) * t;
+        if (on_path - on_axis).length_squared() < inner * inner {
+            // The step entered. Distance to a convex shape is convex along a line, so it
+            // falls monotonically from `prev` to the closest approach: bisect for the
+            // first point at `limit`.
+            let (mut lo, mut hi) = (0.0f32, s);
+            if dist(prev) > limit {
+                for _ in 0..32 {
+                    let mid = 0.5 * (lo + hi);
+                    if dist(prev + (p - prev) * mid) > limit {
+                        lo = mid;
+                    } else {
+                        hi = mid;
+                    }
+                }
+            }
+            let contact = prev + (p - prev) * lo;
+            let n = normalize_or(
+                contact - closest_point_on_segment(contact, a, b),
+                prev_fallback(),
+            );
+            let rest = p - contact;
+            let slid = contact + rest - n * rest.dot(n).min(0.0);
+            return outside_capsule(slid, a, b, limit, n);
+        }
+    }
+    outside_capsule(p, a, b, limit, prev_fallback())
+}
+
+/// `p`, or the nearest point of the capsule's surface when it is inside.
+fn outside_capsule(p: Vec3, a: Vec3, b: Vec3, limit: f32, fallback: Vec3) -> Vec3 {
     let c = closest_point_on_segment(p, a, b);
     let d = p - c;
     if d.length_squared() < limit * limit {
-        let fallback = normalize_or(
-            prev - closest_point_on_segment(prev, a, b),
-            (b - a).any_orthonormal_vector(),
-        );
-        return c + normalize_or(d, fallback) * limit;
+        c + normalize_or(d, fallback) * limit
+    } else {
+        p
     }
-    let (s, t) = closest_params_segment_segment(prev, p, a, b);
-    let on_path = prev + (p - prev) * s;
-    let on_axis = a + (b - a) * t;
-    let prev_c = closest_point_on_segment(prev, a, b);
-    if (on_path - on_axis).length_squared() < limit * limit
-        && (prev - prev_c).length_squared() >= limit * limit
-    {
-        return prev_c + normalize_or(prev - prev_c, Vec3::Y) * limit;
-    }
-    p
 }
 
 /// Violation depth of `p` against the capsule `a`–`b` inflated by `limit`.

@@ -75,6 +75,13 @@ impl Shape {
     }
 }
 
+/// How far inside a shape a step's path must dip before it counts as entering it: points
+/// pushed exactly onto a surface sit there only to f32 rounding, and a point sliding along
+/// it must not be taken for one that passed through (1e-4 of the contact distance).
+pub(crate) fn contact_tolerance(limit: f32) -> f32 {
+    1e-4 * limit
+}
+
 /// A shape placed in the solver's space.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PlacedCollider {

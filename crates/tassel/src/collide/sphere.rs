@@ -3,24 +3,45 @@
 use crate::math::{closest_point_on_segment, normalize_or};
 use glam::Vec3;
 
-/// Pushes `p` out of the sphere (`center`, `limit` = sphere radius + point radius) along
-/// the shortest way. A point that crossed the whole sphere during the step (`prev` → `p`)
-/// is put back on the side it came from.
+/// Pushes `p` out of the sphere (`center`, `limit` = sphere radius + point radius).
+///
+/// A point inside is pushed out along the shortest way. A point whose step (`prev` → `p`)
+/// entered the sphere from outside — by more than a rounding tolerance, so that a point
+/// resting on or sliding along the surface is never mistaken for one — is stopped where
+/// the step met the surface and keeps the tangential part of the rest of its step: it
+/// slides, it is never sent back to `prev`. That also catches a step that passed right
+/// through (tunnelling).
 pub fn push_out_of_sphere(p: Vec3, prev: Vec3, center: Vec3, limit: f32) -> Vec3 {
-    let d = p - center;
-    let dist2 = d.length_squared();
-    if dist2 < limit * limit {
-        let fallback = normalize_or(prev - center, Vec3::Y);
-        return center + normalize_or(d, fallback) * limit;
-    }
-    // Swept: did the path pass through the sphere?
+    let tol = super::contact_tolerance(limit);
+    let prev_out = (prev - center).length_squared() >= (limit - tol).max(0.0).powi(2);
     let c = closest_point_on_segment(center, prev, p);
-    if (c - center).length_squared() < limit * limit
-        && (prev - center).length_squared() >= limit * limit
-    {
-        return center + normalize_or(prev - center, Vec3::Y) * limit;
+    if prev_out && (c - center).length_squared() < (limit - tol).max(0.0).powi(2) {
+        // The step entered: where it first met the surface, |o + t·v| = limit.
+        let (o, v) = (prev - center, p - prev);
+        let (vv, ov) = (v.length_squared(), o.dot(v));
+        let disc = (ov * ov - vv * (o.length_squared() - limit * limit)).max(0.0);
+        let t = if vv > 0.0 {
+            ((-ov - disc.sqrt()) / vv).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        let contact = prev + v * t;
+        let n = normalize_or(contact - center, normalize_or(o, Vec3::Y));
+        let rest = p - contact;
+        let slid = contact + rest - n * rest.dot(n).min(0.0);
+        return outside_sphere(slid, center, limit, n);
     }
-    p
+    outside_sphere(p, center, limit, normalize_or(prev - center, Vec3::Y))
+}
+
+/// `p`, or the nearest point of the sphere's surface when it is inside.
+fn outside_sphere(p: Vec3, center: Vec3, limit: f32, fallback: Vec3) -> Vec3 {
+    let d = p - center;
+    if d.length_squared() < limit * limit {
+        center + normalize_or(d, fallback) * limit
+    } else {
+        p
+    }
 }
 
 /// Pulls `p` back inside the sphere (`center`, `limit` = sphere radius − point radius).
@@ -56,7 +77,7 @@ mod tests {
             1.0,
         );
         assert!(p.abs_diff_eq(Vec3::X, 1e-6));
-        // Tunnelled straight through in one step: back to the entry side.
+        // Tunnelled straight through in one step, head on: stopped on the entry side.
         let p = push_out_of_sphere(
             Vec3::new(2.0, 0.0, 0.0),
             Vec3::new(-2.0, 0.0, 0.0),
