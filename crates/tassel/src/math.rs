@@ -167,19 +167,22 @@ pub fn normalize_or(v: Vec3, fallback: Vec3) -> Vec3 {
     }
 }
 
-/// The smallest rotation that takes direction `from` to direction `to` (both non-zero).
-/// Antiparallel inputs turn about an axis perpendicular to `from`.
+/// The smallest rotation that takes direction `from` to direction `to` (both non-zero),
+/// exactly: the normalised quaternion (from × to, 1 + from·to) of the unit directions, so
+/// that the smallest swings are kept (no dead zone: a turn of 1e-6 rad is a turn of 1e-6
+/// rad). Antiparallel inputs (1 + from·to below 1e-7, where that form has no precision
+/// left) turn by exactly 180° (w = 0) about an axis perpendicular to `from`. This is the
+/// from-to rotation the VRM specification and three.js's `setFromUnitVectors` use.
 pub fn rotation_arc(from: Vec3, to: Vec3) -> Quat {
     let a = normalize_or(from, Vec3::Y);
     let b = normalize_or(to, a);
-    let d = a.dot(b);
-    if d > 1.0 - 1e-7 {
-        Quat::IDENTITY
-    } else if d < -1.0 + 1e-6 {
-        Quat::from_axis_angle(a.any_orthonormal_vector(), core::f32::consts::PI)
-    } else {
-        Quat::from_rotation_arc(a, b)
+    let w = 1.0 + a.dot(b);
+    if w < 1e-7 {
+        let axis = a.any_orthonormal_vector();
+        return Quat::from_xyzw(axis.x, axis.y, axis.z, 0.0);
     }
+    let c = a.cross(b);
+    Quat::from_xyzw(c.x, c.y, c.z, w).normalize()
 }
 
 /// Closest point to `p` on the segment `a`–`b`.
@@ -282,6 +285,47 @@ pub fn closest_point_on_triangle(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> Vec3 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Small angles by hand: X turned by θ about Z is (0, 0, sin θ/2, cos θ/2), down to
+    /// angles far below the old 1 − 1e-7 dead zone (≈ 4.5e-4 rad).
+    #[test]
+    fn rotation_arc_keeps_tiny_swings() {
+        for theta in [1e-6f32, 1e-5, 1e-4, 4e-4, 1e-3, 0.1, 1.0, 3.0] {
+            let to = Vec3::new(theta.cos(), theta.sin(), 0.0);
+            let q = rotation_arc(Vec3::X, to);
+            let want = Quat::from_xyzw(0.0, 0.0, (theta / 2.0).sin(), (theta / 2.0).cos());
+            assert!(
+                (q.z - want.z).abs() <= 1e-6 * want.z.max(1e-3) + 2e-9
+                    && (q.w - want.w).abs() < 1e-6,
+                "θ = {theta}: {q} vs {want}"
+            );
+            assert!((q * Vec3::X - to).length() < 2e-7, "θ = {theta}");
+        }
+        // Scale does not matter, and from == to is the identity exactly.
+        assert_eq!(
+            rotation_arc(Vec3::new(0.0, 3.0, 0.0), Vec3::Y),
+            Quat::IDENTITY
+        );
+        let q = rotation_arc(Vec3::X * 5.0, Vec3::new(1e-3, 1.0, 0.0) * 0.1);
+        assert!((q * Vec3::X - Vec3::new(1e-3, 1.0, 0.0).normalize()).length() < 2e-7);
+    }
+
+    /// 180°: w exactly 0 and `from` taken to `to`. Just short of it (3.14 rad) the turn is
+    /// right to f32's precision there: 1 + cos θ ≈ 1.3e-6 carries the rounding of the dot
+    /// product (≈ 6e-8), so the axis is exact and the angle within ≈ 1e-4 rad.
+    #[test]
+    fn rotation_arc_half_turn_is_exact() {
+        for from in [Vec3::X, Vec3::Y, Vec3::new(1.0, 2.0, -3.0).normalize()] {
+            let q = rotation_arc(from, -from);
+            assert_eq!(q.w, 0.0, "{from}");
+            assert!((q * from + from).length() < 1e-6, "{from}: {q}");
+            assert!((q.length() - 1.0).abs() < 1e-6);
+        }
+        let to = Vec3::new((3.14f32).cos(), (3.14f32).sin(), 0.0);
+        let q = rotation_arc(Vec3::X, to);
+        assert!((q * Vec3::X - to).length() < 1e-4, "{q}");
+        assert!(q.x == 0.0 && q.y.abs() < 1e-7, "{q}");
+    }
 
     #[test]
     fn inverse_undoes_composition() {
