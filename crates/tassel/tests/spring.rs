@@ -395,3 +395,29 @@ fn owner_motion_is_carried_exactly_at_any_frame_rate() {
 fn d_sideways_ok(run: &[(f32, Vec3)]) -> bool {
     run.iter().all(|(_, d)| d.x.abs() < 1e-3)
 }
+
+/// The error reset also holds the output: an animated bone thrown 1e6 m away for a single
+/// frame of 1/144 s (no step in it) and back leaves the spring bone at its animated
+/// position, not 4e5 m away (found by the simulation fuzzer).
+#[test]
+fn a_target_thrown_away_for_one_frame_does_not_fling_the_bone() {
+    let rest = Vec3::new(0.0, 0.2, 0.0);
+    let mut run = Run::new(SpringSettings {
+        name: "s".into(),
+        bone: "bob".into(),
+        use_rotation: false,
+        max_steps_per_frame: 2,
+        ..Default::default()
+    });
+    run.frame(Transform::IDENTITY, rest, 0.0);
+    run.frame(Transform::IDENTITY, rest, 1.0 / 144.0);
+    run.frame(Transform::IDENTITY, rest - Vec3::splat(1e6), 1.0 / 144.0);
+    for f in 0..5 {
+        let p = run.frame(Transform::IDENTITY, rest, 1.0 / 60.0);
+        assert!(
+            (p.translation - rest).length() <= 0.5,
+            "frame {f} after: {} (animated {rest})",
+            p.translation
+        );
+    }
+}

@@ -262,6 +262,16 @@ impl SpringJob<'_> {
             // Output at this frame's time: this frame's target plus the last step's
             // deviation moved on by the carried-over time, within the displacement limit.
             let mut disp_ws = st.deviation();
+            let too_far = s.error_reset_threshold > 0.0
+                && disp_ws.length_squared() > s.error_reset_threshold.powi(2);
+            if too_far {
+                // The output is held to the error reset too: a target that jumped within
+                // the carried time (an animated bone thrown 1e6 m for one frame) must not
+                // be extrapolated into a swing (found by the simulation fuzzer).
+                st.initialized = false;
+                self.state.resets += 1;
+                disp_ws = Vec3::ZERO;
+            }
             if !disp_ws.is_finite() {
                 // Beyond f32: start again at the target. Validation refuses the settings
                 // that overflow (see `SpringSettings::step_growth`); this stays as the
