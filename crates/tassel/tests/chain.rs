@@ -498,3 +498,40 @@ fn alpha_warmup_and_turn_teleport() {
         assert!(p.abs_diff_eq(turned.transform_point(rest.models[i].translation), 1e-5));
     }
 }
+
+/// `classic_gravity`: one classic frame from rest drops a horizontal 1 m bone's tip by
+/// the chosen KawaiiPhysics gravity step δ (g·dt, ½·g·dt² or g·dt²), then the bone length
+/// puts it back on the unit circle: y = −δ / √(1 + δ²), by hand.
+#[test]
+fn classic_gravity_steps_are_kawaiiphysics_three_versions() {
+    use tassel::dynamics::chain::ClassicGravity;
+    let dt = 1.0f32 / 60.0;
+    let g = 9.81f32;
+    for (mode, delta) in [
+        (ClassicGravity::PerFrame, g * dt),
+        (ClassicGravity::HalfDtSquared, 0.5 * g * dt * dt),
+        (ClassicGravity::DtSquared, g * dt * dt),
+    ] {
+        let rig = RigSettings {
+            chains: vec![ChainSettings {
+                classic_gravity: mode,
+                ..free(TimeMode::Classic, 60.0)
+            }],
+            ..Default::default()
+        };
+        let mut sim = Sim::new(line_skeleton(1, 1.0, Vec3::X), rig);
+        sim.frame(Transform::IDENTITY, 0.0);
+        let tip = sim.frame(Transform::IDENTITY, dt)[1];
+        let want = -delta / (1.0 + delta * delta).sqrt();
+        assert!(
+            (tip.y - want).abs() < 1e-6 && ((tip.length() - 1.0).abs() < 1e-6),
+            "{mode:?}: tip {tip}, want y = {want}"
+        );
+    }
+    // Read from a rig file by name.
+    let rig = RigSettings::from_toml_str(
+        "[[chain]]\nname = \"c\"\nroot = \"anchor\"\nmode = \"classic\"\nclassic_gravity = \"half_dt_squared\"\n",
+    )
+    .unwrap();
+    assert_eq!(rig.chains[0].classic_gravity, ClassicGravity::HalfDtSquared);
+}

@@ -13,4 +13,4 @@ mod step;
 
 pub use compile::{ChainRig, PointInfo};
 pub use job::{ChainJob, ChainState};
-pub use settings::{ChainCurves, ChainSettings, PlanarAxis, TimeMode, Wind};
+pub use settings::{ChainCurves, ChainSettings, ClassicGravity, PlanarAxis, TimeMode, Wind};

@@ -9,14 +9,28 @@ use serde::{Deserialize, Serialize};
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum TimeMode {
-    /// One step per rendered frame, exactly as KawaiiPhysics (seed 000) writes it; the look
-    /// depends on the frame rate.
+    /// One step per rendered frame in KawaiiPhysics 1.10's order (seed 000), with the
+    /// differences docs/rig.md lists; the look depends on the frame rate.
     Classic,
     /// Steps of `1 / target_framerate` seconds with the animated targets interpolated across
     /// the sub-steps and the output interpolated between the last two steps: the look no
     /// longer depends on the frame rate.
     #[default]
     Fixed,
+}
+
+/// How `classic` mode applies gravity each frame (KawaiiPhysics changed it twice).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ClassicGravity {
+    /// `x += g·dt`, as seed 000 writes it (KawaiiPhysics before 1.3.1; later kept behind a
+    /// console variable). Gravity then acts as an acceleration of `g / dt`.
+    #[default]
+    PerFrame,
+    /// `x += ½·g·dt²`: KawaiiPhysics' default from 1.3.1 to 1.19 (1.10 included).
+    HalfDtSquared,
+    /// `x += g·dt²`: KawaiiPhysics' default from 1.20.
+    DtSquared,
 }
 
 /// Restricts a bone to a plane through its parent, normal to one of the parent's animated
@@ -109,8 +123,11 @@ pub struct ChainSettings {
     /// Planar constraint axis.
     pub planar_constraint: PlanarAxis,
     /// Gravity. In `fixed` mode an acceleration (m/s²); in `classic` mode applied as
-    /// seed 000 writes it, `location += gravity · dt` each frame.
+    /// `classic_gravity` says (by default as seed 000 writes it, `location += gravity · dt`
+    /// each frame).
     pub gravity: Vec3,
+    /// `classic` mode: which KawaiiPhysics gravity step to use.
+    pub classic_gravity: ClassicGravity,
     /// Gravity given in world space (true) or the character's space (false).
     pub gravity_in_world: bool,
     /// Wind.
@@ -153,6 +170,7 @@ impl Default for ChainSettings {
             planar_constraint: PlanarAxis::None,
             gravity: Vec3::new(0.0, -9.81, 0.0),
             gravity_in_world: true,
+            classic_gravity: ClassicGravity::PerFrame,
             wind: Wind::default(),
             target_framerate: 60.0,
             mode: TimeMode::Fixed,

@@ -1,7 +1,7 @@
 //! One solver step of one chain: the readable, per-point reference path.
 
 use super::compile::{ChainRig, NONE};
-use super::settings::PlanarAxis;
+use super::settings::{ClassicGravity, PlanarAxis};
 use crate::collide::PlacedCollider;
 use crate::math::normalize_or;
 use crate::rng::SplitMix64;
@@ -42,10 +42,11 @@ pub(crate) fn step_chain(
     let chain = &rig.chains[ci];
     let s = &chain.settings;
     let exponent = s.target_framerate * input.dt;
-    let gravity_step = if input.fixed {
-        input.gravity_cs * input.dt * input.dt
-    } else {
-        input.gravity_cs * input.dt
+    let (g, dt) = (input.gravity_cs, input.dt);
+    let gravity_step = match (input.fixed, s.classic_gravity) {
+        (true, _) | (false, ClassicGravity::DtSquared) => g * dt * dt,
+        (false, ClassicGravity::PerFrame) => g * dt,
+        (false, ClassicGravity::HalfDtSquared) => g * (0.5 * dt * dt),
     };
     let wind_on = s.wind.speed > 0.0 && input.wind_cs != Vec3::ZERO;
     let t = input.targets;
