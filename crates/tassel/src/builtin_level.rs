@@ -156,7 +156,7 @@ const GRAVITY: f32 = 9.81;
 /// The demo's run through [`demo_level`]: player input → controller → state machine.
 pub struct LevelRun {
     /// The level.
-    pub level: Level,
+    pub level: std::sync::Arc<Level>,
     /// The character's capsule (1.7 m, radius 0.28 m).
     pub capsule: CharacterCapsule,
     /// Controller settings (defaults).
@@ -195,7 +195,7 @@ impl LevelRun {
         let capsule = CharacterCapsule::with_height(1.7, 0.28);
         let settings = ControllerSettings::default();
         Ok(Self {
-            level: Level::new(demo_level())?,
+            level: std::sync::Arc::new(Level::new(demo_level())?),
             centre: Vec3::new(0.0, capsule.half_total_height() + settings.skin, 0.0),
             capsule,
             settings,

@@ -1,5 +1,6 @@
 //! One character's secondary-motion frame, wiring skeleton, chain rig and state together.
 
+use crate::controller::Level;
 use crate::dynamics::chain::{ChainJob, ChainRig, ChainState};
 use crate::dynamics::cloth::{ClothJob, ClothRig, ClothState};
 use crate::dynamics::rope::Ropes;
@@ -10,6 +11,7 @@ use crate::error::{Error, Result};
 use crate::math::Transform;
 use crate::pose::{LocalToModelJob, Pose};
 use crate::skeleton::Skeleton;
+use std::sync::Arc;
 
 /// A character ready to simulate: its skeleton, compiled rig, state and last pose.
 ///
@@ -35,6 +37,7 @@ pub struct CharacterSim {
     vrm_state: VrmState,
     pose: Pose,
     animated_models: Vec<Transform>,
+    level: Option<Arc<Level>>,
 }
 
 impl CharacterSim {
@@ -120,6 +123,7 @@ impl CharacterSim {
             vrm_state,
             pose,
             animated_models,
+            level: None,
         })
     }
 
@@ -186,6 +190,7 @@ impl CharacterSim {
             dt,
             locals: &mut self.pose.locals,
             models: &mut self.pose.models,
+            level: self.level.as_deref(),
         }
         .run()?;
         if !self.springs.is_empty() {
@@ -220,6 +225,17 @@ impl CharacterSim {
             &mut self.pose.models,
         )?;
         Ok(&self.pose)
+    }
+
+    /// Sets the world that chains with `world_collision` keep out of (the controller's
+    /// [`Level`], shared: one world serves the controller and every character), or none.
+    pub fn set_level(&mut self, level: Option<Arc<Level>>) {
+        self.level = level;
+    }
+
+    /// The world the chains collide with, if any.
+    pub fn level(&self) -> Option<&Level> {
+        self.level.as_deref()
     }
 
     /// The skeleton.

@@ -310,7 +310,7 @@ mod tests {
         assert!((q * Vec3::X - Vec3::new(1e-3, 1.0, 0.0).normalize()).length() < 2e-7);
     }
 
-    /// 180°: w exactly 0 and `from` taken to `to`. Just short of it (3.14 rad) the turn is
+    /// 180°: w exactly 0 and `from` taken to `to`. Just short of it (π − 1.6e-3 rad) the turn is
     /// right to f32's precision there: 1 + cos θ ≈ 1.3e-6 carries the rounding of the dot
     /// product (≈ 6e-8), so the axis is exact and the angle within ≈ 1e-4 rad.
     #[test]
@@ -321,7 +321,8 @@ mod tests {
             assert!((q * from + from).length() < 1e-6, "{from}: {q}");
             assert!((q.length() - 1.0).abs() < 1e-6);
         }
-        let to = Vec3::new((3.14f32).cos(), (3.14f32).sin(), 0.0);
+        let near_pi = std::f32::consts::PI - 1.6e-3;
+        let to = Vec3::new(near_pi.cos(), near_pi.sin(), 0.0);
         let q = rotation_arc(Vec3::X, to);
         assert!((q * Vec3::X - to).length() < 1e-4, "{q}");
         assert!(q.x == 0.0 && q.y.abs() < 1e-7, "{q}");

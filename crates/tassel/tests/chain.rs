@@ -59,6 +59,7 @@ impl Sim {
             dt,
             locals: &mut locals,
             models: &mut models,
+            level: None,
         }
         .run()
         .unwrap();
@@ -373,6 +374,7 @@ fn bad_time_steps_and_hitches() {
             dt,
             locals: &mut locals,
             models: &mut models,
+            level: None,
         }
         .run();
         assert!(e.is_err(), "dt {dt} accepted");

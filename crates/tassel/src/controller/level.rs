@@ -466,6 +466,29 @@ impl Level {
         });
     }
 
+    /// Whether any level primitive's bounds overlap the box `lo`–`hi` (a broad-phase
+    /// test: one BVH query).
+    pub(crate) fn touches_aabb(&self, lo: Vec3, hi: Vec3) -> bool {
+        if !(lo.is_finite() && hi.is_finite()) {
+            return false;
+        }
+        self.bvh.intersect_aabb(&Aabb::new(lo, hi)).next().is_some()
+    }
+
+    /// The deepest penetration of a sphere of radius `r` at `p` into the level: its
+    /// depth and the way out; `None` when it touches nothing. Allocates nothing.
+    pub(crate) fn deepest_contact(&self, p: Vec3, r: f32) -> Option<(f32, Vec3)> {
+        let bounds = Aabb::new(p - r, p + r);
+        let mut best: Option<(f32, Vec3)> = None;
+        for leaf in self.bvh.intersect_aabb(&bounds) {
+            let s = self.prims[leaf as usize].separation(p, p, r);
+            if s.distance < 0.0 && best.is_none_or(|(d, _)| -s.distance > d) {
+                best = Some((-s.distance, s.normal));
+            }
+        }
+        best
+    }
+
     /// The deepest penetration of a capsule (`radius`, `half_height` along the local Y of
     /// `rotation`, centred at `position`) into the level, metres; 0 when it is free.
     pub fn capsule_penetration(

@@ -3,7 +3,9 @@
 use super::compile::{ChainRig, NONE, VIRTUAL};
 use super::settings::{PlanarAxis, TimeMode};
 use super::step::{step_chain, StepInput};
+use super::world::{push_out, WorldContact};
 use crate::collide::PlacedCollider;
+use crate::controller::Level;
 use crate::error::{Error, Result};
 use crate::math::{normalize_or, rotation_arc, slerp_shortest, Transform};
 use crate::rng::SplitMix64;
@@ -133,6 +135,8 @@ pub struct ChainJob<'a> {
     pub locals: &'a mut [Transform],
     /// In: animated model transforms. Out: recomputed from the new locals.
     pub models: &'a mut [Transform],
+    /// The world the chains with `world_collision` keep out of (world space), if any.
+    pub level: Option<&'a Level>,
 }
 
 impl ChainJob<'_> {
@@ -181,6 +185,7 @@ impl ChainJob<'_> {
             dt,
             locals,
             models,
+            level,
         } = self;
         gather_targets(
             skeleton,
@@ -192,7 +197,7 @@ impl ChainJob<'_> {
         );
 
         for ci in 0..rig.chains.len() {
-            run_chain(rig, ci, state, &component, dt);
+            run_chain(rig, ci, state, &component, dt, level);
         }
         state.prev_targets.copy_from_slice(&state.targets);
         state.prev_normals.copy_from_slice(&state.normals);
@@ -282,6 +287,7 @@ fn reset_chain(rig: &ChainRig, ci: usize, state: &mut ChainState, component: &Tr
             dt: h,
             dt_old: h,
             fixed: s.mode == TimeMode::Fixed,
+            world: None,
         };
         step_chain(
             rig,
@@ -320,7 +326,46 @@ fn motion_cs(a: &Transform, b: &Transform) -> (Vec3, Quat) {
     )
 }
 
-fn run_chain(rig: &ChainRig, ci: usize, state: &mut ChainState, component: &Transform, dt: f32) {
+/// The world as this chain's step from `from` to `to` sees it: `None` without a level,
+/// without `world_collision`, or when no geometry is within the chain's reach.
+fn world_for<'a>(
+    rig: &ChainRig,
+    ci: usize,
+    level: Option<&'a Level>,
+    pos: &[Vec3],
+    targets: &[Vec3],
+    from: &Transform,
+    to: &Transform,
+) -> Option<WorldContact<'a>> {
+    let chain = &rig.chains[ci];
+    let level = level.filter(|_| chain.settings.world_collision)?;
+    let root = chain.points.start;
+    // Every point stays within the chain's bone lengths of its root.
+    let mut reach = 0.0f32;
+    for p in chain.points.clone() {
+        let parent = rig.parent[p];
+        if parent != NONE {
+            reach += (targets[p] - targets[parent as usize]).length() + rig.radius[p];
+        }
+    }
+    let world = WorldContact {
+        level,
+        from: *from,
+        to: *to,
+    };
+    world
+        .near(pos[root], targets[root], reach + 1e-3)
+        .then_some(world)
+}
+
+fn run_chain(
+    rig: &ChainRig,
+    ci: usize,
+    state: &mut ChainState,
+    component: &Transform,
+    dt: f32,
+    level: Option<&Level>,
+) {
     let s = &rig.chains[ci].settings;
     let points = rig.chains[ci].points.clone();
     // Teleport detection on the character's own motion this frame.
@@ -342,6 +387,15 @@ fn run_chain(rig: &ChainRig, ci: usize, state: &mut ChainState, component: &Tran
                 let dt = dt.min(s.max_delta_time);
                 if dt > 0.0 {
                     let (move_cs, rotate_cs) = motion_cs(&state.prev_component, component);
+                    let world = world_for(
+                        rig,
+                        ci,
+                        level,
+                        &state.pos,
+                        &state.targets,
+                        &state.prev_component,
+                        component,
+                    );
                     let input = StepInput {
                         targets: &state.targets,
                         normals: &state.normals,
@@ -353,6 +407,7 @@ fn run_chain(rig: &ChainRig, ci: usize, state: &mut ChainState, component: &Tran
                         dt,
                         dt_old: state.dt_old[ci],
                         fixed: false,
+                        world,
                     };
                     step_chain(
                         rig,
@@ -369,7 +424,7 @@ fn run_chain(rig: &ChainRig, ci: usize, state: &mut ChainState, component: &Tran
                     state.dev_before[p] = state.dev[p];
                 }
             }
-            TimeMode::Fixed => run_fixed(rig, ci, state, component, dt),
+            TimeMode::Fixed => run_fixed(rig, ci, state, component, dt, level),
         }
     }
     // Guard: never let a non-finite value out; start again from the pose instead.
@@ -401,9 +456,17 @@ fn run_chain(rig: &ChainRig, ci: usize, state: &mut ChainState, component: &Tran
             // The interpolated output also respects this frame's colliders.
             let mut x = restore(t + dev);
             let r = rig.radius[p];
+            let world = level.filter(|_| s.world_collision);
             let collide = |mut x: Vec3| {
                 for &c in &rig.chains[ci].colliders {
                     x = state.colliders[c].resolve(x, x, r);
+                }
+                if let Some(level) = world {
+                    let w = component.transform_point(x);
+                    let out = push_out(level, w, r);
+                    if out != w {
+                        x = component.inverse_transform_point(out);
+                    }
                 }
                 x
             };
@@ -424,7 +487,14 @@ fn slerp_angle(a: Quat, b: Quat) -> f32 {
     2.0 * d.acos()
 }
 
-fn run_fixed(rig: &ChainRig, ci: usize, state: &mut ChainState, component: &Transform, dt: f32) {
+fn run_fixed(
+    rig: &ChainRig,
+    ci: usize,
+    state: &mut ChainState,
+    component: &Transform,
+    dt: f32,
+    level: Option<&Level>,
+) {
     let s = &rig.chains[ci].settings;
     let h = 1.0 / s.target_framerate;
     let acc_old = state.accumulator[ci];
@@ -463,6 +533,15 @@ fn run_fixed(rig: &ChainRig, ci: usize, state: &mut ChainState, component: &Tran
             slerp_shortest(state.prev_component.rotation, component.rotation, w),
         );
         let (move_cs, rotate_cs) = motion_cs(&state.last_step_component[ci], &comp_b);
+        let world = world_for(
+            rig,
+            ci,
+            level,
+            &state.pos,
+            &state.step_targets,
+            &state.last_step_component[ci],
+            &comp_b,
+        );
         let input = StepInput {
             targets: &state.step_targets,
             normals: &state.step_normals,
@@ -474,6 +553,7 @@ fn run_fixed(rig: &ChainRig, ci: usize, state: &mut ChainState, component: &Tran
             dt: h,
             dt_old: h,
             fixed: true,
+            world,
         };
         step_chain(
             rig,

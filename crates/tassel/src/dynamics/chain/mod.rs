@@ -10,6 +10,7 @@ mod compile;
 mod job;
 mod settings;
 mod step;
+mod world;
 
 pub use compile::{ChainRig, PointInfo};
 pub use job::{ChainJob, ChainState};

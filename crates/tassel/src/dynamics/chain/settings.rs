@@ -147,6 +147,9 @@ pub struct ChainSettings {
     pub alpha: f32,
     /// Colliders (by name from the rig) this chain collides with; empty: all of them.
     pub colliders: Vec<String>,
+    /// Also keep every point `radius` out of the world (the [`crate::controller::Level`]
+    /// handed to the frame), swept and sliding.
+    pub world_collision: bool,
     /// `fixed` mode: at most this many steps per frame; time beyond is dropped (hitch guard).
     pub max_steps_per_frame: u32,
     /// `classic` mode: a longer frame is clamped to this, seconds.
@@ -179,6 +182,7 @@ impl Default for ChainSettings {
             warmup_steps: 0,
             alpha: 1.0,
             colliders: Vec::new(),
+            world_collision: false,
             max_steps_per_frame: 10,
             max_delta_time: 0.1,
         }

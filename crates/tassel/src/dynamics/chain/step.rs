@@ -28,6 +28,8 @@ pub(crate) struct StepInput<'a> {
     pub dt_old: f32,
     /// True in fixed mode (gravity as an acceleration).
     pub fixed: bool,
+    /// The world, when the chain collides with it and geometry is near.
+    pub world: Option<super::world::WorldContact<'a>>,
 }
 
 /// Advances the points of chain `ci` by one step.
@@ -93,6 +95,9 @@ pub(crate) fn step_chain(
             for &c in &chain.colliders {
                 x = input.colliders[c].resolve(x, prev[p], r);
             }
+            if let Some(world) = &input.world {
+                x = world.resolve(x, prev[p], r);
+            }
             x
         };
         x = collide(x);
@@ -120,7 +125,7 @@ pub(crate) fn step_chain(
         let fallback = normalize_or(anim_dir, Vec3::Y);
         let restore = |x: Vec3| pos[pp] + normalize_or(x - pos[pp], fallback) * length;
         x = restore(x);
-        if !chain.colliders.is_empty() {
+        if !chain.colliders.is_empty() || input.world.is_some() {
             let mut settled = false;
             for _ in 0..3 {
                 let y = collide(x);
