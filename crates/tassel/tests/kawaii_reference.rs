@@ -199,10 +199,7 @@ fn classic_matches_kawaiiphysics_1_10_without_contacts() {
                     let (pos, rot) = component(motion, t);
                     kp.frame((pos, rot), 1.0 / hz);
                     kp32.frame((pos, rot), 1.0 / hz);
-                    let comp = Transform::from_translation_rotation(
-                        pos.as_vec3(),
-                        Quat::from(rot.as_quat()),
-                    );
+                    let comp = Transform::from_translation_rotation(pos.as_vec3(), rot.as_quat());
                     sim.frame(&rest, comp, (1.0 / hz) as f32).unwrap();
                     for j in 1..=BONES {
                         let got = sim.pose().models[j].translation.as_dvec3();
