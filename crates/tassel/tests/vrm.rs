@@ -408,3 +408,49 @@ fn a_bone_belongs_to_one_solver() {
     let pose = sim.frame(&rest, side, 1.0 / 60.0).unwrap();
     assert!(pose.locals[0].rotation.angle_between(Quat::IDENTITY) > 1e-3);
 }
+
+/// The specification applies each collider a spring lists through its groups, so one
+/// listed twice (group 0 and group 1 both hold collider 0, and the spring lists group 0
+/// twice) acts three times, in group order; it used to be deduplicated (issue 15).
+#[test]
+fn a_collider_listed_twice_acts_twice() {
+    let sphere = VrmCollider {
+        joint: 0,
+        shape: VrmShape::Sphere {
+            offset: Vec3::new(1.0, 1.0, 0.0),
+            radius: 0.1,
+            inside: false,
+        },
+    };
+    let plane = VrmCollider {
+        joint: 0,
+        shape: VrmShape::Plane {
+            offset: Vec3::ZERO,
+            normal: Vec3::Y,
+        },
+    };
+    let bones = VrmSpringBones {
+        colliders: vec![sphere, plane],
+        collider_groups: vec![
+            VrmColliderGroup {
+                name: "a".into(),
+                colliders: vec![0, 1],
+            },
+            VrmColliderGroup {
+                name: "b".into(),
+                colliders: vec![0],
+            },
+        ],
+        springs: vec![spring(
+            VrmJoint {
+                joint: 1,
+                tail: VrmTail::Local(Vec3::X),
+                ..VrmJoint::default()
+            },
+            vec![0, 1, 0],
+        )],
+    };
+    let rig = VrmRig::new(&one_joint(), &bones, VrmOptions::default()).unwrap();
+    let range = rig.links[0].colliders.clone();
+    assert_eq!(&rig.link_colliders[range], &[0, 1, 0, 0, 1]);
+}

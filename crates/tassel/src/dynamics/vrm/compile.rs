@@ -49,7 +49,8 @@ pub struct VrmRig {
     pub links: Vec<VrmLink>,
     /// Collider shapes and their joints.
     pub colliders: Vec<(usize, VrmShape)>,
-    /// Collider indices of each link (deduplicated, in group order).
+    /// Collider indices of each link, in group order (a collider listed twice is there
+    /// twice).
     pub link_colliders: Vec<usize>,
     /// Solver options.
     pub options: VrmOptions,
@@ -64,20 +65,14 @@ impl VrmRig {
         let rest = Pose::rest(skeleton);
         let mut links = Vec::new();
         let mut link_colliders = Vec::new();
-        let mut listed = vec![false; bones.colliders.len()];
         for (si, s) in bones.springs.iter().enumerate() {
-            let mut cols: Vec<usize> = Vec::new();
-            for &g in &s.collider_groups {
-                for &c in &bones.collider_groups[g].colliders {
-                    if !listed[c] {
-                        listed[c] = true;
-                        cols.push(c);
-                    }
-                }
-            }
-            for &c in &cols {
-                listed[c] = false;
-            }
+            // Every listed collider, in group order: one the spring lists twice (through
+            // two groups) acts twice, as the specification, three-vrm and UniVRM apply it.
+            let cols: Vec<usize> = s
+                .collider_groups
+                .iter()
+                .flat_map(|&g| bones.collider_groups[g].colliders.iter().copied())
+                .collect();
             for j in &s.joints {
                 let (tail_joint, tail_local) = match j.tail {
                     VrmTail::Joint(t) => (
