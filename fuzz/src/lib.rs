@@ -50,17 +50,8 @@ pub fn gltf_import(data: &[u8]) {
         let mut cursor = model.clips.first().map(SamplingCursor::new);
         for f in 0..4 {
             let t = f as f32 / 30.0;
-            if let (Some(clip), Some(cursor)) = (model.clips.first(), cursor.as_mut()) {
-                let job = SamplingJob {
-                    clip,
-                    cursor,
-                    time: t,
-                    playback: Playback::Loop,
-                    locals: &mut locals,
-                };
-                if job.run().is_err() {
-                    return;
-                }
+            if !sample(model.clips.first(), cursor.as_mut(), t, &mut locals) {
+                return;
             }
             let component = Transform::from_translation(Vec3::new(0.3 * t, 0.0, 0.0));
             if sim.frame(&locals, component, 1.0 / 30.0).is_ok() {
@@ -147,6 +138,28 @@ pub fn simulation(data: &[u8]) {
     }
 }
 
+/// Samples `clip` (looped) at `t` into `locals`, when there is one; false when the clip
+/// cannot be sampled (a bad clip is the loader's business, not a finding here).
+fn sample(
+    clip: Option<&tassel::anim::Clip>,
+    cursor: Option<&mut SamplingCursor>,
+    t: f32,
+    locals: &mut [Transform],
+) -> bool {
+    let (Some(clip), Some(cursor)) = (clip, cursor) else {
+        return true;
+    };
+    SamplingJob {
+        clip,
+        cursor,
+        time: t,
+        playback: Playback::Loop,
+        locals,
+    }
+    .run()
+    .is_ok()
+}
+
 fn character() -> &'static builtin::Character {
     static CHARACTER: OnceLock<builtin::Character> = OnceLock::new();
     CHARACTER.get_or_init(builtin::character)
@@ -192,17 +205,8 @@ fn drive(sim: &mut CharacterSim, u: &mut Unstructured, frames: u32, what: &str) 
             3 => yaw = special(u),
             _ => position += Vec3::new(0.05, 0.0, 0.02) * (unit(u) - 0.5),
         }
-        if let (Some(clip), Some(cursor)) = (clip, cursor.as_mut()) {
-            let job = SamplingJob {
-                clip,
-                cursor,
-                time: t,
-                playback: Playback::Loop,
-                locals: &mut locals,
-            };
-            if job.run().is_err() {
-                return;
-            }
+        if !sample(clip, cursor.as_mut(), t, &mut locals) {
+            return;
         }
         if u.ratio(1, 8).unwrap_or(false) {
             // A bad animated joint: zero length, NaN or a wild rotation.

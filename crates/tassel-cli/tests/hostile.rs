@@ -46,6 +46,22 @@ fn chain_doc(extra: Value) -> Value {
     d
 }
 
+/// The chain with one clip, `name`: node `node` translated along X from 0 to `x` over
+/// two keys at 0 and `end` seconds (LINEAR).
+fn ramp_clip(name: &str, node: usize, end: f32, x: f32) -> Value {
+    let bytes = [floats(&[0.0, end]), floats(&[0.0, 0.0, 0.0, x, 0.0, 0.0])].concat();
+    chain_doc(json!({
+        "buffers": [{"uri": data_uri(&bytes), "byteLength": 32}],
+        "bufferViews": [{"buffer": 0, "byteLength": 8}, {"buffer": 0, "byteOffset": 8, "byteLength": 24}],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": 2, "type": "SCALAR", "min": [0.0], "max": [end]},
+            {"bufferView": 1, "componentType": 5126, "count": 2, "type": "VEC3"}
+        ],
+        "animations": [{"name": name, "channels": [{"sampler": 0, "target": {"node": node, "path": "translation"}}],
+                        "samplers": [{"input": 0, "output": 1}]}]
+    }))
+}
+
 fn write_json(dir: &Path, name: &str, doc: &Value) -> PathBuf {
     let p = dir.join(name);
     std::fs::write(&p, serde_json::to_vec(doc).unwrap()).unwrap();
@@ -187,17 +203,7 @@ fn loader_problems_are_errors_not_panics() {
 #[test]
 fn a_clip_of_a_billion_seconds_is_refused_by_every_command() {
     let d = tmp("hostile-clip");
-    let bytes = [floats(&[0.0, 1e9]), floats(&[0.0, 0.0, 0.0, 1.0, 0.0, 0.0])].concat();
-    let doc = chain_doc(json!({
-        "buffers": [{"uri": data_uri(&bytes), "byteLength": 32}],
-        "bufferViews": [{"buffer": 0, "byteLength": 8}, {"buffer": 0, "byteOffset": 8, "byteLength": 24}],
-        "accessors": [
-            {"bufferView": 0, "componentType": 5126, "count": 2, "type": "SCALAR", "min": [0.0], "max": [1e9]},
-            {"bufferView": 1, "componentType": 5126, "count": 2, "type": "VEC3"}
-        ],
-        "animations": [{"name": "long", "channels": [{"sampler": 0, "target": {"node": 1, "path": "translation"}}],
-                        "samplers": [{"input": 0, "output": 1}]}]
-    }));
+    let doc = ramp_clip("long", 1, 1e9, 1.0);
     let f = write_json(&d, "long.gltf", &doc);
     let rig = chain_rig(&d, "");
     let keep = ["long.gltf", "rig.toml"];
@@ -359,22 +365,12 @@ fn arguments_past_the_limits_are_refused() {
 }
 
 /// Long runs are streamed: under a 200 MB address-space limit (bash's `ulimit -v`), a
-/// 200 000-frame `simulate` (≈ 80 MB of JSON; 850 MB resident when it was held whole) and a 200 001-time `sample` complete, and
-/// their files parse with the expected counts.
+/// 200 000-frame `simulate` (≈ 80 MB of JSON; 850 MB resident when it was held whole)
+/// and a 200 001-time `sample` complete, and their files parse with the expected counts.
 #[test]
 fn long_runs_stream_within_bounded_memory() {
     let d = tmp("hostile-stream");
-    let bytes = [floats(&[0.0, 1.0]), floats(&[0.0, 0.0, 0.0, 0.5, 0.0, 0.0])].concat();
-    let doc = chain_doc(json!({
-        "buffers": [{"uri": data_uri(&bytes), "byteLength": 32}],
-        "bufferViews": [{"buffer": 0, "byteLength": 8}, {"buffer": 0, "byteOffset": 8, "byteLength": 24}],
-        "accessors": [
-            {"bufferView": 0, "componentType": 5126, "count": 2, "type": "SCALAR", "min": [0.0], "max": [1.0]},
-            {"bufferView": 1, "componentType": 5126, "count": 2, "type": "VEC3"}
-        ],
-        "animations": [{"name": "move", "channels": [{"sampler": 0, "target": {"node": 0, "path": "translation"}}],
-                        "samplers": [{"input": 0, "output": 1}]}]
-    }));
+    let doc = ramp_clip("move", 0, 1.0, 0.5);
     let f = write_json(&d, "m.gltf", &doc);
     let rig = chain_rig(&d, "");
     let bin = env!("CARGO_BIN_EXE_tassel");
