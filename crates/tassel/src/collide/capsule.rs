@@ -19,7 +19,8 @@ pub fn push_out_of_capsule(p: Vec3, prev: Vec3, a: Vec3, b: Vec3, limit: f32) ->
             (b - a).any_orthonormal_vector(),
         )
     };
-    if dist(prev) >= inner {
+    let prev_dist = dist(prev);
+    if prev_dist >= inner {
         let (s, t) = closest_params_segment_segment(prev, p, a, b);
         let on_path = prev + (p - prev) * s;
         let on_axis = a + (b - a) * t;
@@ -28,7 +29,7 @@ pub fn push_out_of_capsule(p: Vec3, prev: Vec3, a: Vec3, b: Vec3, limit: f32) ->
             // falls monotonically from `prev` to the closest approach: bisect for the
             // first point at `limit`.
             let (mut lo, mut hi) = (0.0f32, s);
-            if dist(prev) > limit {
+            if prev_dist > limit {
                 for _ in 0..32 {
                     let mid = 0.5 * (lo + hi);
                     if dist(prev + (p - prev) * mid) > limit {

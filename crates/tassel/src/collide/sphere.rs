@@ -12,10 +12,10 @@ use glam::Vec3;
 /// slides, it is never sent back to `prev`. That also catches a step that passed right
 /// through (tunnelling).
 pub fn push_out_of_sphere(p: Vec3, prev: Vec3, center: Vec3, limit: f32) -> Vec3 {
-    let tol = super::contact_tolerance(limit);
-    let prev_out = (prev - center).length_squared() >= (limit - tol).max(0.0).powi(2);
+    let inner2 = (limit - super::contact_tolerance(limit)).max(0.0).powi(2);
+    let prev_out = (prev - center).length_squared() >= inner2;
     let c = closest_point_on_segment(center, prev, p);
-    if prev_out && (c - center).length_squared() < (limit - tol).max(0.0).powi(2) {
+    if prev_out && (c - center).length_squared() < inner2 {
         // The step entered: where it first met the surface, |o + t·v| = limit.
         let (o, v) = (prev - center, p - prev);
         let (vv, ov) = (v.length_squared(), o.dot(v));

@@ -440,6 +440,18 @@ fn run_chain(
     } else {
         1.0
     };
+    // The world, only when geometry is within the chain's reach this frame (one BVH
+    // query, as in the steps).
+    let world = world_for(
+        rig,
+        ci,
+        level,
+        &state.targets,
+        &state.targets,
+        component,
+        component,
+    )
+    .map(|w| w.level);
     for p in points {
         let t = state.targets[p];
         let dev = state.dev_before[p].lerp(state.dev[p], w) * s.alpha;
@@ -456,7 +468,6 @@ fn run_chain(
             // The interpolated output also respects this frame's colliders.
             let mut x = restore(t + dev);
             let r = rig.radius[p];
-            let world = level.filter(|_| s.world_collision);
             let collide = |mut x: Vec3| {
                 for &c in &rig.chains[ci].colliders {
                     x = state.colliders[c].resolve(x, x, r);

@@ -263,10 +263,11 @@ impl ClothSettings {
         if !(self.step_rate.is_finite() && (10.0..=10_000.0).contains(&self.step_rate)) {
             return bad("step_rate", format!("{} (10..=10000)", self.step_rate));
         }
-        if !(1..=64).contains(&self.max_steps_per_frame) {
+        let max_steps = crate::limits::MAX_STEPS_PER_FRAME;
+        if !(1..=max_steps).contains(&self.max_steps_per_frame) {
             return bad(
                 "max_steps_per_frame",
-                format!("{} (1..=64)", self.max_steps_per_frame),
+                format!("{} (1..={max_steps})", self.max_steps_per_frame),
             );
         }
         if !(1..=64).contains(&self.iterations) {

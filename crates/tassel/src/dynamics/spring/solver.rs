@@ -72,6 +72,11 @@ struct One {
     initialized: bool,
 }
 
+/// Farther from the target than the spring's error reset allows (0 = no reset).
+fn beyond_reset(s: &SpringSettings, d: Vec3) -> bool {
+    s.error_reset_threshold > 0.0 && d.length_squared() > s.error_reset_threshold.powi(2)
+}
+
 impl One {
     /// The displacement from the target at the frame's end: the last step's deviation,
     /// moved on by the carried-over time at the velocity relative to the target. Measured
@@ -231,9 +236,7 @@ impl SpringJob<'_> {
                 let owner = prev_owner.lerp(comp.translation, w);
                 st.location += (owner - st.step_owner) * s.owner_velocity_scale;
                 st.step_owner = owner;
-                if s.error_reset_threshold > 0.0
-                    && (tgt - st.location).length_squared() > s.error_reset_threshold.powi(2)
-                {
+                if beyond_reset(s, tgt - st.location) {
                     st.location = tgt;
                     st.velocity = Vec3::ZERO;
                     self.state.resets += 1;
@@ -262,9 +265,7 @@ impl SpringJob<'_> {
             // Output at this frame's time: this frame's target plus the last step's
             // deviation moved on by the carried-over time, within the displacement limit.
             let mut disp_ws = st.deviation();
-            let too_far = s.error_reset_threshold > 0.0
-                && disp_ws.length_squared() > s.error_reset_threshold.powi(2);
-            if too_far {
+            if beyond_reset(s, disp_ws) {
                 // The output is held to the error reset too: a target that jumped within
                 // the carried time (an animated bone thrown 1e6 m for one frame) must not
                 // be extrapolated into a swing (found by the simulation fuzzer).
