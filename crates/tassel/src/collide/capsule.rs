@@ -27,12 +27,13 @@ pub fn push_out_of_capsule(p: Vec3, prev: Vec3, a: Vec3, b: Vec3, limit: f32) ->
         if (on_path - on_axis).length_squared() < inner * inner {
             // The step entered. Distance to a convex shape is convex along a line, so it
             // falls monotonically from `prev` to the closest approach: bisect for the
-            // first point at `limit`.
+            // first point at `inner`, the surface the test above uses (a path grazing it
+            // is then redirected by nothing: the contact is continuous in its input).
             let (mut lo, mut hi) = (0.0f32, s);
-            if prev_dist > limit {
+            if prev_dist > inner {
                 for _ in 0..32 {
                     let mid = 0.5 * (lo + hi);
-                    if dist(prev + (p - prev) * mid) > limit {
+                    if dist(prev + (p - prev) * mid) > inner {
                         lo = mid;
                     } else {
                         hi = mid;

@@ -8,18 +8,21 @@ use glam::Vec3;
 /// A point inside is pushed out along the shortest way. A point whose step (`prev` → `p`)
 /// entered the sphere from outside — by more than a rounding tolerance, so that a point
 /// resting on or sliding along the surface is never mistaken for one — is stopped where
-/// the step met the surface and keeps the tangential part of the rest of its step: it
-/// slides, it is never sent back to `prev`. That also catches a step that passed right
-/// through (tunnelling).
+/// the step met the surface (less that tolerance: the redirection then fades to nothing
+/// as a path's dip fades to the tolerance, so the result is continuous in the input) and
+/// keeps the tangential part of the rest of its step: it slides, it is never sent back to
+/// `prev`. That also catches a step that passed right through (tunnelling).
 pub fn push_out_of_sphere(p: Vec3, prev: Vec3, center: Vec3, limit: f32) -> Vec3 {
     let inner2 = (limit - super::contact_tolerance(limit)).max(0.0).powi(2);
     let prev_out = (prev - center).length_squared() >= inner2;
     let c = closest_point_on_segment(center, prev, p);
     if prev_out && (c - center).length_squared() < inner2 {
-        // The step entered: where it first met the surface, |o + t·v| = limit.
+        // The step entered: where it first met the entry surface, |o + t·v| = limit −
+        // tolerance (the surface the test above uses, so that a path grazing it is
+        // redirected by nothing and the contact is continuous in its input).
         let (o, v) = (prev - center, p - prev);
         let (vv, ov) = (v.length_squared(), o.dot(v));
-        let disc = (ov * ov - vv * (o.length_squared() - limit * limit)).max(0.0);
+        let disc = (ov * ov - vv * (o.length_squared() - inner2)).max(0.0);
         let t = if vv > 0.0 {
             ((-ov - disc.sqrt()) / vv).clamp(0.0, 1.0)
         } else {
