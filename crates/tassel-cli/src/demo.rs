@@ -46,6 +46,9 @@ pub fn run(a: Args) -> Result<(), String> {
     let sk = &c.skeleton;
     let mut sim = CharacterSim::new(sk.clone(), &c.rig).map_err(|e| e.to_string())?;
     let mut run = LevelRun::new().map_err(|e| e.to_string())?;
+    // One world for the controller and the secondary motion (the skirt and the charm
+    // collide with it).
+    sim.set_level(Some(run.level.clone()));
     let dt = 1.0 / a.fps;
     let frames = (LevelRun::DURATION * a.fps).round() as usize;
     let mut locals = sk.rest().to_vec();

@@ -233,10 +233,12 @@ fn rig() -> RigSettings {
         friction: 0.3,
         limit_angle: 60.0,
         colliders: names(&["thigh_l", "thigh_r", "shin_l", "shin_r"]),
+        // The skirt brushes the wall the demo slides along.
+        world_collision: true,
         ..Default::default()
     }];
-    // The tassel in the left hand: a particle rope, kept out of the left thigh and above
-    // the ground.
+    // The tassel in the left hand: a particle rope, kept out of the left thigh, above
+    // the ground and out of the world (it swings into the demo's wall without it).
     let ropes = vec![RopeSettings {
         name: "charm".into(),
         root: "charm_0".into(),
@@ -244,6 +246,7 @@ fn rig() -> RigSettings {
         mass: 0.05,
         colliders: names(&["thigh_l"]),
         ground: Some(0.0),
+        world_collision: true,
         world: ParticleSettings {
             damping: 0.03,
             iterations: 8,

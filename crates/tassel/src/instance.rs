@@ -214,6 +214,7 @@ impl CharacterSim {
                 dt,
                 locals: &mut self.pose.locals,
                 models: &mut self.pose.models,
+                level: self.level.as_deref(),
             }
             .run()?;
         }
@@ -223,6 +224,7 @@ impl CharacterSim {
             dt,
             &mut self.pose.locals,
             &mut self.pose.models,
+            self.level.as_deref(),
         )?;
         Ok(&self.pose)
     }

@@ -176,6 +176,7 @@ impl Rig {
             dt,
             locals: &mut pose.locals,
             models: &mut pose.models,
+            level: None,
         }
         .run()
         .unwrap();
@@ -366,6 +367,7 @@ fn teleport_resets_to_the_animated_pose() {
             dt: 1.0 / 60.0,
             locals: &mut pose.locals,
             models: &mut pose.models,
+            level: None,
         }
         .run()
         .unwrap();

@@ -12,6 +12,7 @@ mod rig;
 pub mod rope;
 pub mod spring;
 pub mod vrm;
+mod world;
 
 pub use curve::Curve;
 pub use mode::SimMode;

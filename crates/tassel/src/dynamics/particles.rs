@@ -15,6 +15,8 @@
 //! ```
 
 use crate::collide::{PlacedCollider, Shape};
+use crate::controller::Level;
+use crate::dynamics::world::WorldContact;
 use crate::error::{Error, Result};
 use crate::math::{normalize_or, Transform};
 use crate::rng::SplitMix64;
@@ -471,13 +473,27 @@ impl ParticleWorld {
             steps = s.max_steps_per_frame;
         }
         for _ in 0..steps {
-            self.substep(h);
+            self.substep(h, None);
         }
         self.remaining = (self.remaining - steps as f32 * h).max(0.0);
         Ok(())
     }
 
-    fn substep(&mut self, h: f32) {
+    /// One step of `time_step` seconds, the pins where they are now; with `level`, the
+    /// free particles keep `radius` out of it (swept from where the step started, sliding;
+    /// the contact counts for friction). For callers that drive the steps themselves (the
+    /// ropes, which move their pins between steps).
+    pub(crate) fn step_once(&mut self, level: Option<&Level>) {
+        let h = self.settings.time_step;
+        self.substep(h, level);
+    }
+
+    /// Sets where pinned particle `i` is held from the next step on (`i` in range).
+    pub(crate) fn set_pin_target(&mut self, i: usize, at: Vec3) {
+        self.pin_target[i] = Some(at);
+    }
+
+    fn substep(&mut self, h: f32, level: Option<&Level>) {
         let s = &self.settings;
         let keep = 1.0 - s.damping;
         let g = s.gravity * (h * h);
@@ -556,14 +572,19 @@ impl ParticleWorld {
                 }
             }
         }
+        // The world has the last word of the step (one BVH query around the particles).
+        if let Some(level) = level {
+            self.collide_world(level);
+        }
         // Friction once per step: take away part of each touching particle's sliding
         // (tangential) velocity.
-        if s.friction > 0.0 {
+        let friction = self.settings.friction;
+        if friction > 0.0 {
             for i in 0..self.pos.len() {
                 let n = self.contact[i];
                 if n != Vec3::ZERO {
                     let v = self.pos[i] - self.prev[i];
-                    self.prev[i] += (v - n * v.dot(n)) * s.friction;
+                    self.prev[i] += (v - n * v.dot(n)) * friction;
                 }
             }
         }
@@ -571,6 +592,40 @@ impl ParticleWorld {
         for i in 0..self.pos.len() {
             if !self.pos[i].is_finite() {
                 self.pos[i] = self.prev[i];
+            }
+        }
+    }
+}
+
+impl ParticleWorld {
+    /// Keeps the free particles `radius` out of `level`: swept from each one's position
+    /// at the start of the step, sliding along what it meets.
+    fn collide_world(&mut self, level: &Level) {
+        let r = self.settings.radius;
+        let (mut min, mut max) = (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN));
+        for i in 0..self.pos.len() {
+            if self.pin_target[i].is_none() {
+                min = min.min(self.pos[i]).min(self.prev[i]);
+                max = max.max(self.pos[i]).max(self.prev[i]);
+            }
+        }
+        let world = WorldContact {
+            level,
+            from: Transform::IDENTITY,
+            to: Transform::IDENTITY,
+        };
+        if min.x > max.x || !world.near_box(min, max, r + 1e-3) {
+            return;
+        }
+        for i in 0..self.pos.len() {
+            if self.pin_target[i].is_some() {
+                continue;
+            }
+            let before = self.pos[i];
+            let after = world.resolve(before, self.prev[i], r);
+            if after != before {
+                self.pos[i] = after;
+                self.contact[i] = normalize_or(after - before, self.contact[i]);
             }
         }
     }

@@ -1,9 +1,14 @@
 //! Ropes on bones: a chain of bones driven by the particle world (seed 001). The root
-//! bone's particle is attached to the animated root; every other bone is a free particle
-//! tied to its parent by a stick; ground and body colliders act on them; the bones turn
-//! toward the simulated particles. A `[[rope]]` table of the rig file.
+//! bone's particle is pinned to the animated root; every other bone is a free particle
+//! tied to its parent by a stick; ground, body colliders and (optionally) the world act on
+//! them; the bones turn toward the simulated particles. Fixed steps with the pin and the
+//! colliders interpolated between frames, output interpolated between the last two
+//! steps. A `[[rope]]` table of the rig file.
 
+use crate::collide::PlacedCollider;
+use crate::controller::Level;
 use crate::dynamics::particles::{ParticleSettings, ParticleWorld};
+use crate::dynamics::world::push_out;
 use crate::dynamics::{CompiledCollider, RigSettings};
 use crate::error::{Error, Result};
 use crate::math::{rotation_arc, Transform};
@@ -29,6 +34,10 @@ pub struct RopeSettings {
     pub ground: Option<f32>,
     /// Reset when the character moves farther than this in one frame, metres (0 = never).
     pub teleport_distance: f32,
+    /// Also keep every free particle `world.radius` out of the world: the `Level` given to
+    /// `CharacterSim::set_level` (swept from where the step started, sliding, with
+    /// `world.friction`).
+    pub world_collision: bool,
     /// The particle world's parameters (gravity, damping, time step, iterations, radius,
     /// friction, wind, gusts).
     pub world: ParticleSettings,
@@ -44,6 +53,7 @@ impl Default for RopeSettings {
             colliders: Vec::new(),
             ground: None,
             teleport_distance: 1.0,
+            world_collision: false,
             world: ParticleSettings::default(),
         }
     }
@@ -87,11 +97,38 @@ struct CompiledRope {
     colliders: Vec<CompiledCollider>,
 }
 
+/// What one rope carries from frame to frame besides its particle world (world space,
+/// one entry per bone).
+#[derive(Debug, Clone, Default)]
+struct RopeState {
+    /// The animated bone positions at the end of the last frame.
+    prev_anim: Vec<Vec3>,
+    /// This frame's animated bone positions.
+    anim: Vec<Vec3>,
+    /// Each particle's offset from the root particle after the last step and the one
+    /// before it.
+    dev: Vec<Vec3>,
+    dev_before: Vec<Vec3>,
+    /// The output: the interpolated offsets hung from this frame's animated root.
+    out: Vec<Vec3>,
+    /// Colliders at the end of the last frame and now.
+    prev_colliders: Vec<PlacedCollider>,
+    colliders: Vec<PlacedCollider>,
+    /// Time not yet stepped, seconds (< one step).
+    accumulator: f32,
+}
+
 /// Every rope of a rig with its particle world: compile once per character.
+///
+/// Each rope steps its world at the fixed `world.time_step` with the root bone's pin and
+/// the colliders interpolated to each step's time, and shows the particles' offsets from
+/// the root interpolated between the last two steps, hung from this frame's root, so that
+/// the swing does not depend on the frame rate.
 #[derive(Debug, Clone, Default)]
 pub struct Ropes {
     ropes: Vec<CompiledRope>,
     worlds: Vec<ParticleWorld>,
+    states: Vec<RopeState>,
     fresh: Vec<bool>,
     prev_component: Transform,
     resets: u64,
@@ -146,7 +183,18 @@ impl Ropes {
             for w in ids.windows(2) {
                 world.add_stick(w[0], w[1])?;
             }
-            world.attach(ids[0], bones[0], Vec3::ZERO)?;
+            world.pin(ids[0], rest.models[bones[0]].translation)?;
+            let n = bones.len();
+            out.states.push(RopeState {
+                prev_anim: vec![Vec3::ZERO; n],
+                anim: vec![Vec3::ZERO; n],
+                dev: vec![Vec3::ZERO; n],
+                dev_before: vec![Vec3::ZERO; n],
+                out: vec![Vec3::ZERO; n],
+                prev_colliders: Vec::with_capacity(colliders.len()),
+                colliders: Vec::with_capacity(colliders.len()),
+                accumulator: 0.0,
+            });
             out.ropes.push(CompiledRope {
                 settings: s.clone(),
                 bones,
@@ -173,9 +221,18 @@ impl Ropes {
         self.ropes.iter().flat_map(|r| r.bones[1..].iter().copied())
     }
 
-    /// Rope `i`'s particle world (world-space positions, one particle per bone).
+    /// Rope `i`'s particle world (world-space positions after the last step, one particle
+    /// per bone).
     pub fn world(&self, i: usize) -> &ParticleWorld {
         &self.worlds[i]
+    }
+
+    /// Rope `i`'s output positions of the last frame (world space, one per bone, root
+    /// first): the particles' offsets from the root interpolated between the last two
+    /// steps, hung from the animated root with the stick lengths, kept out of the
+    /// colliders; the bones turn toward these.
+    pub fn output_positions(&self, i: usize) -> &[Vec3] {
+        &self.states[i].out
     }
 
     /// Rope `i`'s settings.
@@ -193,9 +250,11 @@ impl Ropes {
         self.fresh.iter_mut().for_each(|f| *f = true);
     }
 
-    /// One frame: moves the attachments and colliders to the pose (`models`, character
-    /// space) at `component`, steps the worlds by `dt`, turns the bones toward the
-    /// particles (writing `locals` and `models`).
+    /// One frame: the animated pose (`models`, character space) at `component`; steps
+    /// each rope's world at its fixed step with the root pin and the colliders
+    /// interpolated from the last frame's, keeps the free particles out of `level` when
+    /// the rope has `world_collision`, and turns the bones toward the output (writing
+    /// `locals` and `models`).
     pub fn frame(
         &mut self,
         skeleton: &Skeleton,
@@ -203,45 +262,118 @@ impl Ropes {
         dt: f32,
         locals: &mut [Transform],
         models: &mut [Transform],
+        level: Option<&Level>,
     ) -> Result<()> {
         if self.ropes.is_empty() {
             return Ok(());
+        }
+        if !(dt.is_finite() && dt >= 0.0) {
+            return Err(Error::InvalidTimeStep(dt));
         }
         let moved = (component.translation - self.prev_component.translation).length();
         self.prev_component = *component;
         let frame = Transform::from_translation_rotation(component.translation, component.rotation);
         for (i, rope) in self.ropes.iter().enumerate() {
             let world = &mut self.worlds[i];
+            let st = &mut self.states[i];
             let s = &rope.settings;
+            world.settings.validate()?;
+            for (k, &b) in rope.bones.iter().enumerate() {
+                st.anim[k] = frame.transform_point(models[b].translation);
+            }
+            st.colliders.clear();
+            for c in &rope.colliders {
+                st.colliders.push(c.place(models, Some(&frame)));
+            }
             if !self.fresh[i] && s.teleport_distance > 0.0 && moved > s.teleport_distance {
                 self.fresh[i] = true;
                 self.resets += 1;
             }
             if self.fresh[i] {
-                for (k, &b) in rope.bones.iter().enumerate() {
-                    world.set_position(k, frame.transform_point(models[b].translation));
+                for k in 0..rope.bones.len() {
+                    world.set_position(k, st.anim[k]);
                 }
+                st.prev_anim.copy_from_slice(&st.anim);
+                st.prev_colliders.clone_from(&st.colliders);
+                for k in 0..rope.bones.len() {
+                    st.dev[k] = st.anim[k] - st.anim[0];
+                    st.dev_before[k] = st.dev[k];
+                }
+                st.accumulator = 0.0;
                 self.fresh[i] = false;
             }
-            world.colliders.clear();
-            for c in &rope.colliders {
-                world.colliders.push(c.place(models, Some(&frame)));
+            let level = level.filter(|_| s.world_collision);
+            let h = world.settings.time_step;
+            let start = st.accumulator;
+            let mut total = start + dt;
+            let mut steps = (total / h + 1e-4).floor() as u32;
+            if steps > world.settings.max_steps_per_frame {
+                total -= (steps - world.settings.max_steps_per_frame) as f32 * h;
+                steps = world.settings.max_steps_per_frame;
             }
-            if let Some(h) = s.ground {
-                world.add_ground(h);
+            for n in 1..=steps {
+                // Where this step's end lies in the frame: 0 = last frame's end, 1 = now.
+                let w = ((n as f32 * h - start) / (total - start).max(h * 1e-3)).clamp(0.0, 1.0);
+                world.set_pin_target(0, st.prev_anim[0].lerp(st.anim[0], w));
+                world.colliders.clear();
+                for (a, b) in st.prev_colliders.iter().zip(&st.colliders) {
+                    world.colliders.push(a.lerp(b, w));
+                }
+                if let Some(g) = s.ground {
+                    world.add_ground(g);
+                }
+                world.step_once(level);
+                for k in 0..rope.bones.len() {
+                    st.dev_before[k] = st.dev[k];
+                    st.dev[k] = world.position(k) - world.position(0);
+                }
             }
-            world.follow_bones(models, &frame)?;
-            world.step(dt)?;
-            // Write-back: each bone turns so its child bone points at the child particle;
-            // directions come from the animated models (positions are not updated until
-            // the pose job at the end), rotations on top of the animated ones.
+            st.accumulator = (total - steps as f32 * h).max(0.0);
+            if (0..rope.bones.len()).any(|k| !world.position(k).is_finite()) {
+                // Never let a non-finite value out: start again from the pose next frame.
+                self.fresh[i] = true;
+                self.resets += 1;
+                for k in 0..rope.bones.len() {
+                    st.dev[k] = st.anim[k] - st.anim[0];
+                    st.dev_before[k] = st.dev[k];
+                }
+            }
+            // Output: the offsets from the root interpolated between the last two steps,
+            // hung from this frame's animated root, stick lengths restored from the root
+            // down, then kept out of this frame's colliders and the world.
+            let w = (st.accumulator / h).clamp(0.0, 1.0);
+            let r = world.settings.radius;
+            st.out[0] = st.anim[0];
+            for k in 1..rope.bones.len() {
+                let length = world.sticks()[k - 1].length;
+                let x = st.anim[0] + st.dev_before[k].lerp(st.dev[k], w);
+                let d = x - st.out[k - 1];
+                let mut x = if d.length_squared() > 1e-18 {
+                    st.out[k - 1] + d * (length / d.length())
+                } else {
+                    x
+                };
+                for c in &st.colliders {
+                    x = c.resolve(x, x, r);
+                }
+                if let Some(g) = s.ground {
+                    x.y = x.y.max(g + r);
+                }
+                if let Some(level) = level {
+                    x = push_out(level, x, r);
+                }
+                st.out[k] = x;
+            }
+            st.prev_anim.copy_from_slice(&st.anim);
+            std::mem::swap(&mut st.prev_colliders, &mut st.colliders);
+            // Write-back: each bone turns so its child bone points at the child's output
+            // position; directions come from the animated models (positions are not
+            // updated until the pose job at the end), rotations on top of the animated ones.
             let inv = frame.inverse();
             for k in 0..rope.bones.len() - 1 {
                 let (j, c) = (rope.bones[k], rope.bones[k + 1]);
                 let anim = models[c].translation - models[j].translation;
-                let a = inv.transform_point(world.position(k));
-                let b = inv.transform_point(world.position(k + 1));
-                let sim = b - a;
+                let sim = inv.transform_point(st.out[k + 1]) - inv.transform_point(st.out[k]);
                 if anim.length_squared() < 1e-12 || sim.length_squared() < 1e-12 {
                     continue;
                 }

@@ -3,9 +3,9 @@
 use super::compile::{ChainRig, NONE, VIRTUAL};
 use super::settings::{PlanarAxis, TimeMode};
 use super::step::{step_chain, StepInput};
-use super::world::{push_out, WorldContact};
 use crate::collide::PlacedCollider;
 use crate::controller::Level;
+use crate::dynamics::world::{push_out, WorldContact};
 use crate::error::{Error, Result};
 use crate::math::{normalize_or, rotation_arc, slerp_shortest, Transform};
 use crate::rng::SplitMix64;

@@ -10,7 +10,6 @@ mod compile;
 mod job;
 mod settings;
 mod step;
-mod world;
 
 pub use compile::{ChainRig, PointInfo};
 pub use job::{ChainJob, ChainState};

@@ -29,7 +29,7 @@ pub(crate) struct StepInput<'a> {
     /// True in fixed mode (gravity as an acceleration).
     pub fixed: bool,
     /// The world, when the chain collides with it and geometry is near.
-    pub world: Option<super::world::WorldContact<'a>>,
+    pub world: Option<crate::dynamics::world::WorldContact<'a>>,
 }
 
 /// Advances the points of chain `ci` by one step.

@@ -3,6 +3,8 @@
 use super::compile::{ClothRig, ConstraintKind};
 use super::contact::{core, push_segment, push_triangle};
 use crate::collide::PlacedCollider;
+use crate::controller::Level;
+use crate::dynamics::world::{push_out, WorldContact};
 use crate::error::{Error, Result};
 use crate::math::{normalize_or, rotation_arc, Transform};
 use crate::rng::SplitMix64;
@@ -124,6 +126,8 @@ pub struct ClothJob<'a> {
     pub locals: &'a mut [Transform],
     /// In: model transforms of the locals. Out: recomputed.
     pub models: &'a mut [Transform],
+    /// The world the cloths with `world_collision` keep out of (world space), if any.
+    pub level: Option<&'a Level>,
 }
 
 impl ClothJob<'_> {
@@ -161,10 +165,12 @@ impl ClothJob<'_> {
             dt,
             locals,
             models,
+            level,
         } = self;
         gather(rig, models, &component, state);
         for ci in 0..rig.cloths.len() {
-            run_cloth(rig, ci, state, &component, dt);
+            let level = level.filter(|_| rig.cloths[ci].settings.world_collision);
+            run_cloth(rig, ci, state, &component, dt, level);
         }
         state.prev_targets.copy_from_slice(&state.targets);
         state.prev_colliders.copy_from_slice(&state.colliders);
@@ -214,7 +220,14 @@ fn reset_cloth(rig: &ClothRig, ci: usize, state: &mut ClothState) {
     state.needs_reset[ci] = false;
 }
 
-fn run_cloth(rig: &ClothRig, ci: usize, state: &mut ClothState, component: &Transform, dt: f32) {
+fn run_cloth(
+    rig: &ClothRig,
+    ci: usize,
+    state: &mut ClothState,
+    component: &Transform,
+    dt: f32,
+    level: Option<&Level>,
+) {
     let cloth = &rig.cloths[ci];
     let s = &cloth.settings;
     if !state.needs_reset[ci] {
@@ -254,7 +267,7 @@ fn run_cloth(rig: &ClothRig, ci: usize, state: &mut ClothState, component: &Tran
         for i in 0..state.colliders.len() {
             state.step_colliders[i] = state.prev_colliders[i].lerp(&state.colliders[i], w);
         }
-        step(rig, ci, state, h);
+        step(rig, ci, state, h, level);
         let bad = cloth.points.clone().any(|p| !state.pos[p].is_finite());
         if bad {
             state.resets += 1;
@@ -283,8 +296,9 @@ fn run_cloth(rig: &ClothRig, ci: usize, state: &mut ClothState, component: &Tran
     if s.force_length_limit {
         limit_lengths(rig, ci, &mut state.out_world, None);
     }
+    let world = level.and_then(|level| near_world(rig, ci, level, &state.out_world, None));
     for _ in 0..3 {
-        let touched = collide(
+        let mut touched = collide(
             rig,
             ci,
             &state.colliders,
@@ -293,6 +307,15 @@ fn run_cloth(rig: &ClothRig, ci: usize, state: &mut ClothState, component: &Tran
             None,
             false,
         );
+        if let Some(world) = &world {
+            for p in cloth.points.clone() {
+                if !rig.fixed[p] {
+                    let out = push_out(world.level, state.out_world[p], rig.radius[p]);
+                    touched |= out != state.out_world[p];
+                    state.out_world[p] = out;
+                }
+            }
+        }
         if !touched {
             break;
         }
@@ -303,8 +326,39 @@ fn run_cloth(rig: &ClothRig, ci: usize, state: &mut ClothState, component: &Tran
     }
 }
 
+/// The world for cloth `ci` when some level geometry lies within its points' bounds
+/// (`pos`, and `prev` when given) grown by their largest radius: one BVH query.
+fn near_world<'a>(
+    rig: &ClothRig,
+    ci: usize,
+    level: &'a Level,
+    pos: &[Vec3],
+    prev: Option<&[Vec3]>,
+) -> Option<WorldContact<'a>> {
+    let cloth = &rig.cloths[ci];
+    let (mut min, mut max, mut r) = (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN), 0.0f32);
+    for p in cloth.points.clone() {
+        if rig.fixed[p] {
+            continue;
+        }
+        min = min.min(pos[p]);
+        max = max.max(pos[p]);
+        if let Some(prev) = prev {
+            min = min.min(prev[p]);
+            max = max.max(prev[p]);
+        }
+        r = r.max(rig.radius[p]);
+    }
+    let world = WorldContact {
+        level,
+        from: Transform::IDENTITY,
+        to: Transform::IDENTITY,
+    };
+    (min.x <= max.x && world.near_box(min, max, r + 1e-3)).then_some(world)
+}
+
 /// One fixed step of cloth `ci` with `state.step_targets` and `state.step_colliders`.
-fn step(rig: &ClothRig, ci: usize, state: &mut ClothState, h: f32) {
+fn step(rig: &ClothRig, ci: usize, state: &mut ClothState, h: f32, level: Option<&Level>) {
     let cloth = &rig.cloths[ci];
     let s = &cloth.settings;
     let g_dir = normalize_or(s.gravity, Vec3::NEG_Y);
@@ -387,6 +441,22 @@ fn step(rig: &ClothRig, ci: usize, state: &mut ClothState, h: f32) {
     }
     if s.limit_angle > 0.0 {
         limit_angles(rig, ci, &state.step_targets, &mut state.pos);
+    }
+    // The world has the last word of the step: swept from where each point started it,
+    // sliding; a point that touched loses the cloth's friction on the next step.
+    if let Some(world) =
+        level.and_then(|level| near_world(rig, ci, level, &state.pos, Some(&state.prev)))
+    {
+        for p in cloth.points.clone() {
+            if rig.fixed[p] {
+                continue;
+            }
+            let x = world.resolve(state.pos[p], state.prev[p], rig.radius[p]);
+            if x != state.pos[p] {
+                state.pos[p] = x;
+                state.friction[p] = state.friction[p].max(rig.friction[p]);
+            }
+        }
     }
 }
 

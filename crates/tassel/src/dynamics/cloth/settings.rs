@@ -153,6 +153,10 @@ pub struct ClothSettings {
     pub segment_collision: bool,
     /// Collision of the quads.
     pub surface_collision: SurfaceCollision,
+    /// Also keep every free point `radius` out of the world: the `Level` given to
+    /// `CharacterSim::set_level` (swept from the point's position before the step, sliding,
+    /// with the cloth's friction).
+    pub world_collision: bool,
     /// Largest angle, degrees, between a segment and where its parent segment's swing
     /// takes its animated direction (0 = no limit).
     pub limit_angle: f32,
@@ -196,6 +200,7 @@ impl Default for ClothSettings {
             friction: 0.3,
             colliders: Vec::new(),
             segment_collision: true,
+            world_collision: false,
             surface_collision: SurfaceCollision::PushPull,
             limit_angle: 0.0,
             max_speed: 0.0,

@@ -1,15 +1,16 @@
-//! World collision of chains: simulated points kept out of a [`Level`] (the controller's
-//! static world), swept so that fast bones do not pass through thin walls, and sliding
-//! along what they touch. After KawaiiPhysics' `bAllowWorldCollision` (seed 000): each
-//! bone is a sphere of the chain's `radius` against the world's geometry.
+//! World collision of chains, cloths and ropes: simulated points kept out of a [`Level`]
+//! (the controller's static world), swept so that fast bones do not pass through thin
+//! walls, and sliding along what they touch. After KawaiiPhysics' `bAllowWorldCollision`
+//! (seed 000): each bone is a sphere of its `radius` against the world's geometry.
 
 use crate::controller::Level;
 use crate::math::Transform;
 use glam::Vec3;
 
-/// The world as one step of one chain sees it: the level, and the character's transform
-/// at the start (`from`: where the points' previous positions are expressed) and at the
-/// end of the step (`to`: where the new positions are).
+/// The world as one step of one solver sees it: the level, and the transform of the
+/// solver's space at the start (`from`: where the points' previous positions are
+/// expressed) and at the end of the step (`to`: where the new positions are); the
+/// identity for solvers in world space (cloths, ropes).
 #[derive(Clone, Copy)]
 pub(crate) struct WorldContact<'a> {
     pub level: &'a Level,
@@ -26,6 +27,12 @@ impl WorldContact<'_> {
         let a = self.from.transform_point(root_before);
         let b = self.to.transform_point(root_after);
         self.level.touches_aabb(a.min(b) - reach, a.max(b) + reach)
+    }
+
+    /// Only when some level geometry lies within the box `min`–`max` (world space) grown
+    /// by `margin`: one BVH query for a whole cloth or rope per step.
+    pub fn near_box(&self, min: Vec3, max: Vec3, margin: f32) -> bool {
+        self.level.touches_aabb(min - margin, max + margin)
     }
 
     /// `x` (step space) whose previous position was `prev` (previous step's space), kept
