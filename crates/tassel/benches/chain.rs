@@ -25,7 +25,7 @@ fn chain_frame(c: &mut Criterion) {
 }
 
 /// World collision on a chain away from all geometry (500 m above a 1 000-collider level)
-/// against the same frame without the option: one BVH query per chain per step.
+/// against the same frame without the option: one BVH query per character and frame.
 fn world_far(c: &mut Criterion) {
     let (sk, mut rig) = builtin::bench_character(16, 8, 8);
     let level = std::sync::Arc::new(

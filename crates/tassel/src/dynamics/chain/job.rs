@@ -196,6 +196,9 @@ impl ChainJob<'_> {
             &mut state.colliders,
         );
 
+        // One broad-phase query for the whole character; away from all geometry the
+        // chains ask the level nothing more.
+        let level = level.filter(|level| near_character(rig, state, &component, level));
         for ci in 0..rig.chains.len() {
             run_chain(rig, ci, state, &component, dt, level);
         }
@@ -326,6 +329,44 @@ fn motion_cs(a: &Transform, b: &Transform) -> (Vec3, Quat) {
     )
 }
 
+/// How far any point of chain `ci` (with its radius) can be from the chain's root: its
+/// bone lengths in `targets` and radii, summed.
+fn chain_reach(rig: &ChainRig, ci: usize, targets: &[Vec3]) -> f32 {
+    let mut reach = 0.0f32;
+    for p in rig.chains[ci].points.clone() {
+        let parent = rig.parent[p];
+        if parent != NONE {
+            reach += (targets[p] - targets[parent as usize]).length() + rig.radius[p];
+        }
+    }
+    reach
+}
+
+/// Whether any level geometry lies within reach of a chain that collides with the world,
+/// anywhere along this frame: one BVH query around every such chain's root at the last
+/// frame's end and now, grown by its reach (and a quarter of the root's travel, for a
+/// step path that bends away from the straight line).
+fn near_character(
+    rig: &ChainRig,
+    state: &ChainState,
+    component: &Transform,
+    level: &Level,
+) -> bool {
+    let (mut lo, mut hi) = (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN));
+    for (ci, chain) in rig.chains.iter().enumerate() {
+        if !chain.settings.world_collision {
+            continue;
+        }
+        let root = chain.points.start;
+        let a = state.prev_component.transform_point(state.pos[root]);
+        let b = component.transform_point(state.targets[root]);
+        let margin = chain_reach(rig, ci, &state.targets) + 0.25 * (b - a).length() + 1e-2;
+        lo = lo.min(a.min(b) - margin);
+        hi = hi.max(a.max(b) + margin);
+    }
+    lo.x <= hi.x && level.touches_aabb(lo, hi)
+}
+
 /// The world as this chain's step from `from` to `to` sees it: `None` without a level,
 /// without `world_collision`, or when no geometry is within the chain's reach.
 fn world_for<'a>(
@@ -340,14 +381,7 @@ fn world_for<'a>(
     let chain = &rig.chains[ci];
     let level = level.filter(|_| chain.settings.world_collision)?;
     let root = chain.points.start;
-    // Every point stays within the chain's bone lengths of its root.
-    let mut reach = 0.0f32;
-    for p in chain.points.clone() {
-        let parent = rig.parent[p];
-        if parent != NONE {
-            reach += (targets[p] - targets[parent as usize]).length() + rig.radius[p];
-        }
-    }
+    let reach = chain_reach(rig, ci, targets);
     let world = WorldContact {
         level,
         from: *from,
