@@ -39,7 +39,9 @@ pub struct ParticleSettings {
     pub radius: f32,
     /// Hitch guard: at most this many steps per call.
     pub max_steps_per_frame: u32,
-    /// Share of the sliding velocity a particle loses on each contact, 0..=1.
+    /// Share of the sliding velocity a particle loses on each contact step, 0..=1: the
+    /// whole share when the contact pushed it out by at least gravity's push of one step
+    /// (|gravity|·time_step²), proportionally less for a lighter touch.
     pub friction: f32,
     /// Wind as an acceleration, m/s² (world space).
     pub wind: Vec3,
@@ -567,7 +569,7 @@ impl ParticleWorld {
                     let after = col.resolve(before, self.prev[i], s.radius);
                     if after != before {
                         self.pos[i] = after;
-                        self.contact[i] = normalize_or(after - before, self.contact[i]);
+                        self.contact[i] += after - before;
                     }
                 }
             }
@@ -578,13 +580,22 @@ impl ParticleWorld {
         }
         // Friction once per step: take away part of each touching particle's sliding
         // (tangential) velocity.
+        // A contact that pushed the particle out by at least what gravity pushes it in
+        // one step gets the whole share; a lighter touch proportionally less, so that a
+        // grazing touch does not brake a particle all at once (an on/off friction makes
+        // the motion jump with rounding: a rope's swing then parts by centimetres between
+        // runs whose inputs differ by a micrometre).
         let friction = self.settings.friction;
         if friction > 0.0 {
+            let full = (self.settings.gravity.length() * h * h).max(1e-9);
             for i in 0..self.pos.len() {
-                let n = self.contact[i];
-                if n != Vec3::ZERO {
+                let push = self.contact[i];
+                let depth = push.length();
+                if depth > 0.0 {
+                    let n = push / depth;
+                    let share = friction * (depth / full).min(1.0);
                     let v = self.pos[i] - self.prev[i];
-                    self.prev[i] += (v - n * v.dot(n)) * friction;
+                    self.prev[i] += (v - n * v.dot(n)) * share;
                 }
             }
         }
@@ -625,7 +636,7 @@ impl ParticleWorld {
             let after = world.resolve(before, self.prev[i], r);
             if after != before {
                 self.pos[i] = after;
-                self.contact[i] = normalize_or(after - before, self.contact[i]);
+                self.contact[i] += after - before;
             }
         }
     }
