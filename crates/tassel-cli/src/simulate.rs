@@ -132,6 +132,11 @@ enum Tail {
     Local(glam::Vec3),
     /// A virtual chain point (model space, from the chain state).
     ChainPoint(usize),
+    /// A virtual cloth tip (world space, from the cloth state) and the virtual bone's
+    /// length: the written bone's tip, toward that point.
+    ClothPoint(usize, f32),
+    /// None: the joint itself (a spring bone without children).
+    Own,
 }
 
 pub fn run(a: Args) -> Result<(), String> {
@@ -197,6 +202,37 @@ pub fn run(a: Args) -> Result<(), String> {
             },
         )
     }));
+    // Springs: the bone (its first child as the tail).
+    for i in 0..sim.springs().len() {
+        let j = sim.springs().joint(i);
+        let child = (j + 1..skeleton.len()).find(|&c| skeleton.parent(c) == Some(j));
+        joints.push((j, child.map_or(Tail::Own, Tail::Joint)));
+    }
+    // Cloths: every joint that turns toward a free point of its chain, that point as the
+    // tail (a bone, or the chain's virtual tip).
+    let cloths = sim.cloths();
+    for ci in 0..cloths.cloth_count() {
+        let tip = cloths.settings(ci).virtual_bone_length;
+        for chain in cloths.chains(ci) {
+            for p in chain.start..chain.end.saturating_sub(1) {
+                let next = p + 1;
+                if let (Some(j), false) = (cloths.joint(p), cloths.is_fixed(next)) {
+                    joints.push((
+                        j,
+                        cloths
+                            .joint(next)
+                            .map_or(Tail::ClothPoint(next, tip), Tail::Joint),
+                    ));
+                }
+            }
+        }
+    }
+    // Ropes: each bone but the last turns toward the next.
+    for ri in 0..sim.ropes().len() {
+        for pair in sim.ropes().bones(ri).windows(2) {
+            joints.push((pair[0], Tail::Joint(pair[1])));
+        }
+    }
     let rest = skeleton.rest().to_vec();
     let world = |sim: &CharacterSim, comp: &Transform| {
         let models = &sim.pose().models;
@@ -210,6 +246,11 @@ pub fn run(a: Args) -> Result<(), String> {
                 Tail::Joint(t) => comp.transform_point(models[t].translation),
                 Tail::Local(p) => w.transform_point(p),
                 Tail::ChainPoint(p) => comp.transform_point(sim.state().output_positions()[p]),
+                Tail::ClothPoint(p, length) => {
+                    let toward = sim.cloth_state().world_positions()[p] - w.translation;
+                    w.translation + toward.normalize_or_zero() * length
+                }
+                Tail::Own => w.translation,
             };
             tails.push(tail_pos.to_array());
             quats.push(w.rotation.normalize().to_array());

@@ -8,6 +8,7 @@
 use crate::collide::PlacedCollider;
 use crate::controller::Level;
 use crate::dynamics::particles::{ParticleSettings, ParticleWorld};
+use crate::dynamics::path::CharacterPath;
 use crate::dynamics::world::push_out;
 use crate::dynamics::{CompiledCollider, RigSettings};
 use crate::error::{Error, Result};
@@ -105,6 +106,13 @@ struct RopeState {
     prev_anim: Vec<Vec3>,
     /// This frame's animated bone positions.
     anim: Vec<Vec3>,
+    /// The same in the character's space, now and at the last frame's end (the steps
+    /// carry them along the character's path).
+    model_anim: Vec<Vec3>,
+    prev_model_anim: Vec<Vec3>,
+    /// Colliders in the character's space, now and at the last frame's end.
+    colliders_cs: Vec<PlacedCollider>,
+    prev_colliders_cs: Vec<PlacedCollider>,
     /// Each particle's offset from the root particle after the last step and the one
     /// before it.
     dev: Vec<Vec3>,
@@ -131,6 +139,8 @@ pub struct Ropes {
     states: Vec<RopeState>,
     fresh: Vec<bool>,
     prev_component: Transform,
+    /// The character's recent transforms: where it was at each step's time.
+    path: CharacterPath,
     resets: u64,
 }
 
@@ -188,6 +198,10 @@ impl Ropes {
             out.states.push(RopeState {
                 prev_anim: vec![Vec3::ZERO; n],
                 anim: vec![Vec3::ZERO; n],
+                model_anim: vec![Vec3::ZERO; n],
+                prev_model_anim: vec![Vec3::ZERO; n],
+                colliders_cs: Vec::with_capacity(colliders.len()),
+                prev_colliders_cs: Vec::with_capacity(colliders.len()),
                 dev: vec![Vec3::ZERO; n],
                 dev_before: vec![Vec3::ZERO; n],
                 out: vec![Vec3::ZERO; n],
@@ -235,6 +249,12 @@ impl Ropes {
         &self.states[i].out
     }
 
+    /// Rope `i`'s bones, root first (the root follows the animation; each further bone
+    /// hangs from the one before it).
+    pub fn bones(&self, i: usize) -> &[usize] {
+        &self.ropes[i].bones
+    }
+
     /// Rope `i`'s settings.
     pub fn settings(&self, i: usize) -> &RopeSettings {
         &self.ropes[i].settings
@@ -272,6 +292,7 @@ impl Ropes {
         }
         let moved = (component.translation - self.prev_component.translation).length();
         self.prev_component = *component;
+        self.path.push(*component, dt);
         let frame = Transform::from_translation_rotation(component.translation, component.rotation);
         for (i, rope) in self.ropes.iter().enumerate() {
             let world = &mut self.worlds[i];
@@ -279,11 +300,14 @@ impl Ropes {
             let s = &rope.settings;
             world.settings.validate()?;
             for (k, &b) in rope.bones.iter().enumerate() {
+                st.model_anim[k] = models[b].translation;
                 st.anim[k] = frame.transform_point(models[b].translation);
             }
             st.colliders.clear();
+            st.colliders_cs.clear();
             for c in &rope.colliders {
                 st.colliders.push(c.place(models, Some(&frame)));
+                st.colliders_cs.push(c.place(models, None));
             }
             if !self.fresh[i] && s.teleport_distance > 0.0 && moved > s.teleport_distance {
                 self.fresh[i] = true;
@@ -294,13 +318,16 @@ impl Ropes {
                     world.set_position(k, st.anim[k]);
                 }
                 st.prev_anim.copy_from_slice(&st.anim);
+                st.prev_model_anim.copy_from_slice(&st.model_anim);
                 st.prev_colliders.clone_from(&st.colliders);
+                st.prev_colliders_cs.clone_from(&st.colliders_cs);
                 for k in 0..rope.bones.len() {
                     st.dev[k] = st.anim[k] - st.anim[0];
                     st.dev_before[k] = st.dev[k];
                 }
                 st.accumulator = 0.0;
                 self.fresh[i] = false;
+                self.path.reset(*component);
             }
             let level = level.filter(|_| s.world_collision);
             let h = world.settings.time_step;
@@ -314,10 +341,18 @@ impl Ropes {
             for n in 1..=steps {
                 // Where this step's end lies in the frame: 0 = last frame's end, 1 = now.
                 let w = ((n as f32 * h - start) / (total - start).max(h * 1e-3)).clamp(0.0, 1.0);
-                world.set_pin_target(0, st.prev_anim[0].lerp(st.anim[0], w));
+                // The root and the colliders (character space) interpolated to the step's
+                // time, carried along the character's path.
+                let comp = self.path.at(w);
+                let root = st.prev_model_anim[0].lerp(st.model_anim[0], w);
+                world.set_pin_target(0, comp.transform_point(root));
                 world.colliders.clear();
-                for (a, b) in st.prev_colliders.iter().zip(&st.colliders) {
-                    world.colliders.push(a.lerp(b, w));
+                for (a, b) in st.prev_colliders_cs.iter().zip(&st.colliders_cs) {
+                    let cs = a.lerp(b, w);
+                    world.colliders.push(PlacedCollider {
+                        shape: cs.shape,
+                        transform: comp * cs.transform,
+                    });
                 }
                 if let Some(g) = s.ground {
                     world.add_ground(g);
@@ -365,7 +400,9 @@ impl Ropes {
                 st.out[k] = x;
             }
             st.prev_anim.copy_from_slice(&st.anim);
+            st.prev_model_anim.copy_from_slice(&st.model_anim);
             std::mem::swap(&mut st.prev_colliders, &mut st.colliders);
+            std::mem::swap(&mut st.prev_colliders_cs, &mut st.colliders_cs);
             // Write-back: each bone turns so its child bone points at the child's output
             // position; directions come from the animated models (positions are not
             // updated until the pose job at the end), rotations on top of the animated ones.

@@ -5,9 +5,10 @@ use super::settings::{PlanarAxis, TimeMode};
 use super::step::{step_chain, StepInput};
 use crate::collide::PlacedCollider;
 use crate::controller::Level;
+use crate::dynamics::path::CharacterPath;
 use crate::dynamics::world::{push_out, WorldContact};
 use crate::error::{Error, Result};
-use crate::math::{normalize_or, rotation_arc, slerp_shortest, Transform};
+use crate::math::{normalize_or, rotation_arc, Transform};
 use crate::rng::SplitMix64;
 use crate::skeleton::Skeleton;
 use glam::{Quat, Vec3};
@@ -17,6 +18,8 @@ use glam::{Quat, Vec3};
 /// [`ChainState::teleport`].
 #[derive(Debug, Clone)]
 pub struct ChainState {
+    /// The character's recent transforms: where it was at each step's time.
+    path: CharacterPath,
     pos: Vec<Vec3>,
     prev: Vec<Vec3>,
     // Deviation from the step's targets after the last and the one-before-last step
@@ -53,6 +56,7 @@ impl ChainState {
             transform: Transform::IDENTITY,
         };
         Self {
+            path: CharacterPath::default(),
             pos: vec![Vec3::ZERO; n],
             prev: vec![Vec3::ZERO; n],
             dev: vec![Vec3::ZERO; n],
@@ -196,6 +200,7 @@ impl ChainJob<'_> {
             &mut state.colliders,
         );
 
+        state.path.push(component, dt);
         // One broad-phase query for the whole character; away from all geometry the
         // chains ask the level nothing more.
         let level = level.filter(|level| near_character(rig, state, &component, level));
@@ -458,7 +463,7 @@ fn run_chain(
                     state.dev_before[p] = state.dev[p];
                 }
             }
-            TimeMode::Fixed => run_fixed(rig, ci, state, component, dt, level),
+            TimeMode::Fixed => run_fixed(rig, ci, state, dt, level),
         }
     }
     // Guard: never let a non-finite value out; start again from the pose instead.
@@ -532,14 +537,7 @@ fn slerp_angle(a: Quat, b: Quat) -> f32 {
     2.0 * d.acos()
 }
 
-fn run_fixed(
-    rig: &ChainRig,
-    ci: usize,
-    state: &mut ChainState,
-    component: &Transform,
-    dt: f32,
-    level: Option<&Level>,
-) {
+fn run_fixed(rig: &ChainRig, ci: usize, state: &mut ChainState, dt: f32, level: Option<&Level>) {
     let s = &rig.chains[ci].settings;
     let h = 1.0 / s.target_framerate;
     let acc_old = state.accumulator[ci];
@@ -570,13 +568,7 @@ fn run_fixed(
         for &c in &rig.chains[ci].colliders {
             state.step_colliders[c] = state.prev_colliders[c].lerp(&state.colliders[c], w);
         }
-        let comp_b = Transform::from_translation_rotation(
-            state
-                .prev_component
-                .translation
-                .lerp(component.translation, w),
-            slerp_shortest(state.prev_component.rotation, component.rotation, w),
-        );
+        let comp_b = state.path.at(w);
         let (move_cs, rotate_cs) = motion_cs(&state.last_step_component[ci], &comp_b);
         let world = world_for(
             rig,

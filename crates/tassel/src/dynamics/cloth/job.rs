@@ -4,6 +4,7 @@ use super::compile::{ClothRig, ConstraintKind};
 use super::contact::{core, push_segment, push_triangle};
 use crate::collide::PlacedCollider;
 use crate::controller::Level;
+use crate::dynamics::path::CharacterPath;
 use crate::dynamics::world::{push_out, WorldContact};
 use crate::error::{Error, Result};
 use crate::math::{normalize_or, rotation_arc, Transform};
@@ -18,11 +19,19 @@ pub struct ClothState {
     pos: Vec<Vec3>,
     prev: Vec<Vec3>,
     dev: Vec<Vec3>,
+    dev_before: Vec<Vec3>,
     friction: Vec<f32>,
     targets: Vec<Vec3>,
     prev_targets: Vec<Vec3>,
     step_targets: Vec<Vec3>,
     model_targets: Vec<Vec3>,
+    prev_model_targets: Vec<Vec3>,
+    /// Colliders placed in the character's space, now and at the last frame's end (the
+    /// steps carry them along the character's path).
+    colliders_cs: Vec<PlacedCollider>,
+    prev_colliders_cs: Vec<PlacedCollider>,
+    /// The character's recent transforms: where it was at each step's time.
+    path: CharacterPath,
     out_world: Vec<Vec3>,
     out: Vec<Vec3>,
     colliders: Vec<PlacedCollider>,
@@ -49,11 +58,16 @@ impl ClothState {
             pos: vec![Vec3::ZERO; n],
             prev: vec![Vec3::ZERO; n],
             dev: vec![Vec3::ZERO; n],
+            dev_before: vec![Vec3::ZERO; n],
             friction: vec![0.0; n],
             targets: vec![Vec3::ZERO; n],
             prev_targets: vec![Vec3::ZERO; n],
             step_targets: vec![Vec3::ZERO; n],
             model_targets: vec![Vec3::ZERO; n],
+            prev_model_targets: vec![Vec3::ZERO; n],
+            colliders_cs: vec![placed; m],
+            prev_colliders_cs: vec![placed; m],
+            path: CharacterPath::default(),
             out_world: vec![Vec3::ZERO; n],
             out: vec![Vec3::ZERO; n],
             colliders: vec![placed; m],
@@ -168,12 +182,17 @@ impl ClothJob<'_> {
             level,
         } = self;
         gather(rig, models, &component, state);
+        state.path.push(component, dt);
         for ci in 0..rig.cloths.len() {
             let level = level.filter(|_| rig.cloths[ci].settings.world_collision);
             run_cloth(rig, ci, state, &component, dt, level);
         }
         state.prev_targets.copy_from_slice(&state.targets);
+        state
+            .prev_model_targets
+            .copy_from_slice(&state.model_targets);
         state.prev_colliders.copy_from_slice(&state.colliders);
+        state.prev_colliders_cs.copy_from_slice(&state.colliders_cs);
         state.prev_component = component;
         write_back(skeleton, rig, state, locals, models);
         crate::pose::LocalToModelJob {
@@ -201,8 +220,14 @@ fn gather(rig: &ClothRig, models: &[Transform], component: &Transform, state: &m
         state.targets[p] = component.transform_point(m);
     }
     let frame = Transform::from_translation_rotation(component.translation, component.rotation);
-    for (placed, c) in state.colliders.iter_mut().zip(&rig.colliders) {
+    for ((placed, cs), c) in state
+        .colliders
+        .iter_mut()
+        .zip(state.colliders_cs.iter_mut())
+        .zip(&rig.colliders)
+    {
         *placed = c.place(models, Some(&frame));
+        *cs = c.place(models, None);
     }
 }
 
@@ -211,10 +236,13 @@ fn reset_cloth(rig: &ClothRig, ci: usize, state: &mut ClothState) {
         state.pos[p] = state.targets[p];
         state.prev[p] = state.targets[p];
         state.prev_targets[p] = state.targets[p];
+        state.prev_model_targets[p] = state.model_targets[p];
         state.dev[p] = Vec3::ZERO;
+        state.dev_before[p] = Vec3::ZERO;
         state.friction[p] = 0.0;
     }
     state.prev_colliders.copy_from_slice(&state.colliders);
+    state.prev_colliders_cs.copy_from_slice(&state.colliders_cs);
     state.sides[ci].iter_mut().for_each(|s| *s = 0);
     state.accumulator[ci] = 0.0;
     state.needs_reset[ci] = false;
@@ -245,6 +273,7 @@ fn run_cloth(
     }
     if state.needs_reset[ci] {
         reset_cloth(rig, ci, state);
+        state.path.reset(*component);
     }
     let h = 1.0 / s.step_rate;
     let start = state.accumulator[ci];
@@ -261,11 +290,19 @@ fn run_cloth(
         } else {
             1.0
         };
+        // The animated pose and the colliders (character space) interpolated to the
+        // step's time, carried along the character's path.
+        let comp = state.path.at(w);
         for p in cloth.points.clone() {
-            state.step_targets[p] = state.prev_targets[p].lerp(state.targets[p], w);
+            state.step_targets[p] =
+                comp.transform_point(state.prev_model_targets[p].lerp(state.model_targets[p], w));
         }
         for i in 0..state.colliders.len() {
-            state.step_colliders[i] = state.prev_colliders[i].lerp(&state.colliders[i], w);
+            let cs = state.prev_colliders_cs[i].lerp(&state.colliders_cs[i], w);
+            state.step_colliders[i] = PlacedCollider {
+                shape: cs.shape,
+                transform: comp * cs.transform,
+            };
         }
         step(rig, ci, state, h, level);
         let bad = cloth.points.clone().any(|p| !state.pos[p].is_finite());
@@ -274,23 +311,21 @@ fn run_cloth(
             reset_cloth(rig, ci, state);
             break;
         }
-    }
-    state.accumulator[ci] = (total - steps as f32 * h).max(0.0);
-    if steps > 0 {
-        if s.force_length_limit {
-            limit_lengths(rig, ci, &mut state.pos, Some(&mut state.prev));
-        }
         for p in cloth.points.clone() {
+            state.dev_before[p] = state.dev[p];
             state.dev[p] = state.pos[p] - state.step_targets[p];
         }
     }
-    // Output: the last step's deviation carried onto this frame's animated pose, then made
-    // to respect lengths and the colliders where they are now.
+    state.accumulator[ci] = (total - steps as f32 * h).max(0.0);
+    // Output: the deviation from the animated pose interpolated between the last two
+    // steps, carried onto this frame's pose, then made to respect lengths and the
+    // colliders where they are now.
+    let w = (state.accumulator[ci] / h).clamp(0.0, 1.0);
     for p in cloth.points.clone() {
         state.out_world[p] = if rig.fixed[p] {
             state.targets[p]
         } else {
-            state.targets[p] + state.dev[p]
+            state.targets[p] + state.dev_before[p].lerp(state.dev[p], w)
         };
     }
     if s.force_length_limit {
@@ -441,6 +476,11 @@ fn step(rig: &ClothRig, ci: usize, state: &mut ClothState, h: f32, level: Option
     }
     if s.limit_angle > 0.0 {
         limit_angles(rig, ci, &state.step_targets, &mut state.pos);
+    }
+    // Every step (not every frame, which would make the look depend on the frame rate):
+    // no chain segment longer than at rest, without adding velocity.
+    if s.force_length_limit {
+        limit_lengths(rig, ci, &mut state.pos, Some(&mut state.prev));
     }
     // The world has the last word of the step: swept from where each point started it,
     // sliding; a point that touched loses the cloth's friction on the next step.

@@ -162,7 +162,7 @@ pub struct ClothSettings {
     pub limit_angle: f32,
     /// Largest speed of a point, m/s (0 = no limit).
     pub max_speed: f32,
-    /// After the frame's steps, no chain segment is longer than its rest length.
+    /// After every step, no chain segment is longer than its rest length.
     pub force_length_limit: bool,
     /// Steps per second (SPCRJointDynamics uses 120).
     pub step_rate: f32,

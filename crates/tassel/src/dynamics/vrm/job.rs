@@ -4,6 +4,7 @@
 use super::collide::PlacedVrmCollider;
 use super::compile::{VrmLink, VrmRig};
 use super::settings::VrmMode;
+use crate::dynamics::path::CharacterPath;
 use crate::error::{Error, Result};
 use crate::math::{normalize_or, rotation_arc, slerp_shortest, Transform};
 use crate::pose::LocalToModelJob;
@@ -14,6 +15,8 @@ use glam::{Quat, Vec3};
 /// (in world space, or in its spring's centre space) and its last two rotations.
 #[derive(Debug, Clone)]
 pub struct VrmState {
+    /// The character's recent transforms: where it was at each fixed step's time.
+    path: CharacterPath,
     current_tail: Vec<Vec3>,
     prev_tail: Vec<Vec3>,
     length: Vec<f32>,
@@ -40,6 +43,7 @@ impl VrmState {
             normal: Vec3::Y,
         };
         Self {
+            path: CharacterPath::default(),
             current_tail: vec![Vec3::ZERO; l],
             prev_tail: vec![Vec3::ZERO; l],
             length: vec![0.0; l],
@@ -170,6 +174,7 @@ impl VrmJob<'_> {
         if rig.links.is_empty() {
             return Ok(());
         }
+        state.path.push(component, dt);
         let opts = &rig.options;
         if !state.needs_reset && opts.teleport_distance > 0.0 {
             let moved = (component.translation - state.prev_component.translation).length();
@@ -188,7 +193,7 @@ impl VrmJob<'_> {
                     }
                     state.rotation_before.copy_from_slice(&state.rotation);
                 }
-                VrmMode::Fixed => run_fixed(skeleton, rig, state, &component, dt, locals),
+                VrmMode::Fixed => run_fixed(skeleton, rig, state, dt, locals),
             }
         }
         // Guard: never let a non-finite value out; start again from the pose instead.
@@ -478,14 +483,7 @@ fn refresh(sk: &Skeleton, locals: &[Transform], models: &mut [Transform], from: 
 
 /// Fixed mode: whole steps of `1/step_rate` up to now, each with the animated pose and the
 /// character transform interpolated to its time; remembers the last two step rotations.
-fn run_fixed(
-    sk: &Skeleton,
-    rig: &VrmRig,
-    state: &mut VrmState,
-    component: &Transform,
-    dt: f32,
-    locals: &[Transform],
-) {
+fn run_fixed(sk: &Skeleton, rig: &VrmRig, state: &mut VrmState, dt: f32, locals: &[Transform]) {
     let opts = &rig.options;
     let h = 1.0 / opts.step_rate;
     let acc_old = state.accumulator;
@@ -512,13 +510,7 @@ fn run_fixed(
         {
             *s = a.lerp(b, w);
         }
-        let comp = Transform::from_translation_rotation(
-            state
-                .prev_component
-                .translation
-                .lerp(component.translation, w),
-            slerp_shortest(state.prev_component.rotation, component.rotation, w),
-        );
+        let comp = state.path.at(w);
         let mut step_locals = std::mem::take(&mut state.step_locals);
         let mut step_models = std::mem::take(&mut state.step_models);
         refresh(sk, &step_locals, &mut step_models, 0, sk.len() - 1);
