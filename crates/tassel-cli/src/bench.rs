@@ -28,6 +28,7 @@ pub struct Args {
 enum VrmBenchMode {
     Spec,
     Fixed,
+    ThreeVrm,
 }
 
 /// The bench rig's chains and colliders as VRM springs: every non-root chain bone swings
@@ -106,6 +107,7 @@ pub fn run(a: Args) -> Result<(), String> {
             let mode = match m {
                 VrmBenchMode::Spec => VrmMode::Spec,
                 VrmBenchMode::Fixed => VrmMode::Fixed,
+                VrmBenchMode::ThreeVrm => VrmMode::ThreeVrm,
             };
             let options = VrmOptions {
                 mode,

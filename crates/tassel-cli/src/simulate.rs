@@ -13,6 +13,8 @@ pub enum Mode {
     Spec,
     Fixed,
     Classic,
+    /// VRM springs as three-vrm 3.5.5 runs them in a web app.
+    ThreeVrm,
 }
 
 impl From<Mode> for SimMode {
@@ -21,6 +23,7 @@ impl From<Mode> for SimMode {
             Mode::Spec => SimMode::Spec,
             Mode::Fixed => SimMode::Fixed,
             Mode::Classic => SimMode::Classic,
+            Mode::ThreeVrm => SimMode::ThreeVrm,
         }
     }
 }

@@ -406,4 +406,15 @@ fn bake_bad_input_fails_cleanly() {
         &out,
         "no VRM springs",
     );
+    assert_bake_fails(
+        &[
+            fox.as_os_str(),
+            "--rig".as_ref(),
+            rig.as_os_str(),
+            "--mode".as_ref(),
+            "three-vrm".as_ref(),
+        ],
+        &out,
+        "mode three-vrm is a VRM spring-bone mode",
+    );
 }

@@ -413,7 +413,12 @@ fn inspect_lists_vrm_springs_and_clips() {
 
 #[test]
 fn bench_runs_chains_and_vrm_springs() {
-    for extra in [&[][..], &["--vrm", "spec"][..], &["--vrm", "fixed"][..]] {
+    for extra in [
+        &[][..],
+        &["--vrm", "spec"][..],
+        &["--vrm", "fixed"][..],
+        &["--vrm", "three-vrm"][..],
+    ] {
         let out = tassel()
             .args(["bench", "--frames", "20", "--runs", "1"])
             .args(extra)

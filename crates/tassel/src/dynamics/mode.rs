@@ -18,15 +18,19 @@ pub enum SimMode {
     /// Chains frame by frame as KawaiiPhysics does (VRM springs by the specification): the
     /// frame-rate-dependent pair, for comparison.
     Classic,
+    /// VRM springs as three-vrm 3.5.5 runs them in a web app ([`VrmMode::ThreeVrm`]): what
+    /// web viewers show; rig chains keep the mode the rig file gives them.
+    ThreeVrm,
 }
 
 impl SimMode {
-    /// `spec`, `fixed` or `classic`.
+    /// `spec`, `fixed`, `classic` or `three-vrm`.
     pub fn name(self) -> &'static str {
         match self {
             SimMode::Spec => "spec",
             SimMode::Fixed => "fixed",
             SimMode::Classic => "classic",
+            SimMode::ThreeVrm => "three-vrm",
         }
     }
 
@@ -47,13 +51,13 @@ impl SimMode {
                 _ => SimMode::Fixed,
             },
         };
-        if mode == SimMode::Spec && !has_vrm {
-            return Err(Error::InvalidParameter(
-                "mode spec is the VRM spring-bone mode and this model has no VRM springs; use fixed or classic"
-                    .into(),
-            ));
+        if matches!(mode, SimMode::Spec | SimMode::ThreeVrm) && !has_vrm {
+            return Err(Error::InvalidParameter(format!(
+                "mode {} is a VRM spring-bone mode and this model has no VRM springs; use fixed or classic",
+                mode.name()
+            )));
         }
-        if requested.is_some() && mode != SimMode::Spec {
+        if requested.is_some() && matches!(mode, SimMode::Fixed | SimMode::Classic) {
             for c in &mut rig.chains {
                 c.mode = if mode == SimMode::Classic {
                     TimeMode::Classic
@@ -63,10 +67,10 @@ impl SimMode {
             }
         }
         let options = VrmOptions {
-            mode: if mode == SimMode::Fixed {
-                VrmMode::Fixed
-            } else {
-                VrmMode::Spec
+            mode: match mode {
+                SimMode::Fixed => VrmMode::Fixed,
+                SimMode::ThreeVrm => VrmMode::ThreeVrm,
+                SimMode::Spec | SimMode::Classic => VrmMode::Spec,
             },
             ..VrmOptions::default()
         };

@@ -20,6 +20,8 @@ pub struct VrmState {
     current_tail: Vec<Vec3>,
     prev_tail: Vec<Vec3>,
     length: Vec<f32>,
+    /// three-vrm mode: each link's tail node (world) at the end of the previous frame.
+    stale_tail: Vec<Vec3>,
     rotation: Vec<Quat>,
     rotation_before: Vec<Quat>,
     placed: Vec<PlacedVrmCollider>,
@@ -47,6 +49,7 @@ impl VrmState {
             current_tail: vec![Vec3::ZERO; l],
             prev_tail: vec![Vec3::ZERO; l],
             length: vec![0.0; l],
+            stale_tail: vec![Vec3::ZERO; l],
             rotation: vec![Quat::IDENTITY; l],
             rotation_before: vec![Quat::IDENTITY; l],
             placed: vec![none; rig.colliders.len()],
@@ -186,10 +189,12 @@ impl VrmJob<'_> {
             reset(skeleton, rig, state, &component, locals, models);
         } else {
             match opts.mode {
-                VrmMode::Spec => {
+                VrmMode::Spec | VrmMode::ThreeVrm => {
                     if dt > 0.0 {
                         place_colliders(rig, state, &component, models);
-                        update(skeleton, rig, state, &component, dt, false, locals, models);
+                        update(
+                            skeleton, rig, state, &component, dt, opts.mode, locals, models,
+                        );
                     }
                     state.rotation_before.copy_from_slice(&state.rotation);
                 }
@@ -206,7 +211,7 @@ impl VrmJob<'_> {
         state.prev_component = component;
         // Output: the last rotations (fixed mode: between the last two steps).
         let w = match opts.mode {
-            VrmMode::Spec => 1.0,
+            VrmMode::Spec | VrmMode::ThreeVrm => 1.0,
             VrmMode::Fixed => (state.accumulator * opts.step_rate).clamp(0.0, 1.0),
         };
         if opts.mode == VrmMode::Fixed {
@@ -231,6 +236,10 @@ impl VrmJob<'_> {
             // The interpolated pose lags a step and may cut through a collider between
             // two steps: it is pushed out by this frame's colliders like a step's tail.
             collide_output(skeleton, rig, state, &component, locals, models);
+        }
+        if opts.mode == VrmMode::ThreeVrm {
+            // Where each tail node ends this frame: next frame's bone length measures to it.
+            record_tails(rig, state, &component, models);
         }
         Ok(())
     }
@@ -306,9 +315,20 @@ fn reset(
         state.rotation[i] = l.rest_local.rotation;
         state.rotation_before[i] = l.rest_local.rotation;
     }
+    record_tails(rig, state, component, models);
     state.accumulator = 0.0;
     state.needs_reset = false;
     state.resets += 1;
+}
+
+/// Each link's tail (world) from the written pose: its tail node, or the virtual tail.
+fn record_tails(rig: &VrmRig, state: &mut VrmState, component: &Transform, models: &[Transform]) {
+    for (i, l) in rig.links.iter().enumerate() {
+        state.stale_tail[i] = match l.tail_joint {
+            Some(t) => (*component * models[t]).translation,
+            None => (*component * models[l.joint]).transform_point(l.tail_local),
+        };
+    }
 }
 
 fn place_colliders(
@@ -322,9 +342,10 @@ fn place_colliders(
     }
 }
 
-/// One update of every link with time step `dt` (the specification's procedure; `exact`:
-/// fixed mode's settling after the pushes): `models` must be the model pose of `locals`;
-/// both are updated as rotations are written.
+/// One update of every link with time step `dt` (the specification's procedure; in fixed
+/// mode with the settling after the pushes; in three-vrm mode with the bone length to the
+/// tail's place at the end of the last frame): `models` must be the model pose of
+/// `locals`; both are updated as rotations are written.
 #[allow(clippy::too_many_arguments)]
 fn update(
     sk: &Skeleton,
@@ -332,10 +353,11 @@ fn update(
     state: &mut VrmState,
     component: &Transform,
     dt: f32,
-    exact: bool,
+    mode: VrmMode,
     locals: &mut [Transform],
     models: &mut [Transform],
 ) {
+    let exact = mode == VrmMode::Fixed;
     // Model transforms at or above this index are stale (a rotation above them changed).
     let mut stale_from = sk.len();
     for (i, l) in rig.links.iter().enumerate() {
@@ -355,7 +377,12 @@ fn update(
         let inertia = (current - prev) * (1.0 - l.drag_force);
         let stiffness = rest_dir * (l.stiffness * dt);
         let external = l.gravity * dt;
-        let length = state.length[i];
+        let length = match (mode, l.tail_joint) {
+            // three-vrm re-measures the bone against the tail node's world matrix, which
+            // still holds the end of the last frame.
+            (VrmMode::ThreeVrm, Some(_)) => (state.stale_tail[i] - position).length(),
+            _ => state.length[i],
+        };
         let next = position
             + normalize_or(
                 current + inertia + stiffness + external - position,
@@ -522,7 +549,7 @@ fn run_fixed(sk: &Skeleton, rig: &VrmRig, state: &mut VrmState, dt: f32, locals:
             state,
             &comp,
             h,
-            true,
+            VrmMode::Fixed,
             &mut step_locals,
             &mut step_models,
         );

@@ -5,9 +5,10 @@
 //!   `tassel-gltf` crate reads them from a `.vrm`).
 //! - [`VrmRig`]: compiled for a skeleton; [`VrmState`]: one character's tails;
 //!   [`VrmJob`]: one frame.
-//! - [`VrmMode::Spec`] runs the update once per frame exactly as UniVRM and three-vrm do;
-//!   [`VrmMode::Fixed`] runs it at a fixed rate with interpolated output, so that the look
-//!   does not change with the frame rate.
+//! - [`VrmMode::Spec`] runs the update once per frame exactly as the specification and
+//!   UniVRM do; [`VrmMode::ThreeVrm`] as three-vrm 3.5.5 does in a web app (the bone
+//!   length re-measured against last frame's tail); [`VrmMode::Fixed`] runs it at a fixed
+//!   rate with interpolated output, so that the look does not change with the frame rate.
 //!
 //! ```
 //! use tassel::dynamics::vrm::*;

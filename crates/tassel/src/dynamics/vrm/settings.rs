@@ -318,14 +318,22 @@ impl VrmSpringBones {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum VrmMode {
-    /// The specification's algorithm once per frame with the frame's `dt`, exactly as
-    /// UniVRM and three-vrm run it (the look depends on the frame rate).
+    /// The specification's algorithm once per frame with the frame's `dt`, exactly as the
+    /// specification and UniVRM run it (three-vrm too, but for its bone length: see
+    /// [`VrmMode::ThreeVrm`]); the look depends on the frame rate.
     #[default]
     Spec,
     /// The same update at a fixed internal rate, inputs interpolated within the frame and
     /// output interpolated between the last two steps: the look does not depend on the
     /// frame rate.
     Fixed,
+    /// three-vrm 3.5.5 as a web app runs it (`vrm.update(dt)`, then the render updates the
+    /// world matrices): the specification's update once per frame, but each bone's length
+    /// re-measured every update from the joint's current world position to where its tail
+    /// node was at the end of the previous frame (the initial pose on the first frame; a
+    /// virtual tail's own length), which lengthens and shortens bones while the character
+    /// moves. Matches what users see in web viewers built on three-vrm.
+    ThreeVrm,
 }
 
 /// Runtime options of the spring-bone solver (not part of the file).
