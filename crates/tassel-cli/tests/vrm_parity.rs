@@ -188,3 +188,140 @@ fn three_vrm_mode_matches_three_vrm_as_an_app_runs_it() {
         "spec mode should differ from three-vrm's stale bone length: {spec} m"
     );
 }
+
+/// VRMC_node_constraint 1.0 against `@pixiv/three-vrm-node-constraint` (issue 15): the
+/// shared `sphere-collider.gltf` with its springs taken out, rest rotations given to three
+/// nodes and three constraints added that depend on one another (the collider node takes
+/// node B's rotation at weight 0.7; node D rolls about Y with the collider node at 0.9;
+/// node E aims its +X at the collider node at 0.8), while nodes A and B turn (swing and
+/// twist, `tests/oracles/node_constraint_oracle.mjs` has the same motion). Every node's
+/// world position within 1e-4 m and world rotation within 1e-4 rad of three-vrm's, 120
+/// frames.
+#[test]
+fn node_constraints_match_three_vrm() {
+    use base64::Engine;
+    use glam::{Quat, Vec3};
+    let Some(oracle) = oracle_dir() else { return };
+    let Some(src) = testdata("vrm/sphere-collider.gltf") else {
+        return;
+    };
+    // The edited file, its buffer inlined.
+    let mut json: Value = serde_json::from_slice(&std::fs::read(&src).unwrap()).unwrap();
+    let bin = std::fs::read(src.parent().unwrap().join("sphere_mesh.bin")).unwrap();
+    json["buffers"][0]["uri"] = Value::from(format!(
+        "data:application/octet-stream;base64,{}",
+        base64::engine::general_purpose::STANDARD.encode(&bin)
+    ));
+    json["extensions"]
+        .as_object_mut()
+        .unwrap()
+        .remove("VRMC_springBone");
+    json["extensionsUsed"] = serde_json::json!(["VRMC_node_constraint"]);
+    let rot = |axis: [f32; 3], angle: f32| {
+        let q = Quat::from_axis_angle(Vec3::from(axis).normalize(), angle);
+        serde_json::json!([q.x, q.y, q.z, q.w])
+    };
+    json["nodes"][1]["rotation"] = rot([0.0, 0.0, 1.0], 0.4);
+    json["nodes"][3]["rotation"] = rot([1.0, 0.0, 0.0], -0.5);
+    json["nodes"][5]["rotation"] = rot([0.0, 1.0, 1.0], 0.7);
+    let constraint = |c: Value| serde_json::json!({"VRMC_node_constraint": {"specVersion": "1.0", "constraint": c}});
+    json["nodes"][5]["extensions"] =
+        constraint(serde_json::json!({"rotation": {"source": 1, "weight": 0.7}}));
+    json["nodes"][3]["extensions"] =
+        constraint(serde_json::json!({"roll": {"source": 5, "rollAxis": "Y", "weight": 0.9}}));
+    json["nodes"][4]["extensions"] = constraint(
+        serde_json::json!({"aim": {"source": 5, "aimAxis": "PositiveX", "weight": 0.8}}),
+    );
+    let dir = tmp("node-constraints");
+    let file = dir.join("constrained.gltf");
+    std::fs::write(&file, serde_json::to_vec(&json).unwrap()).unwrap();
+
+    // The oracle.
+    std::fs::copy(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/oracles/node_constraint_oracle.mjs"),
+        oracle.join("node_constraint_oracle.mjs"),
+    )
+    .unwrap();
+    let (frames, dt) = (120usize, 1.0f64 / 60.0);
+    let out = dir.join("oracle.json");
+    let run = Command::new("node")
+        .current_dir(&oracle)
+        .arg("node_constraint_oracle.mjs")
+        .arg(&file)
+        .args([
+            "--frames",
+            &frames.to_string(),
+            "--dt",
+            &format!("{dt:.12}"),
+            "--out",
+        ])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(
+        run.status.success(),
+        "oracle: {}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let reference: Value = serde_json::from_slice(&std::fs::read(&out).unwrap()).unwrap();
+    assert_eq!(reference["constraints"], 3);
+
+    // Tassel: the same file, the same motion.
+    let model = tassel_gltf::load(&file).unwrap();
+    let vrm = model.vrm.clone().expect("the constraints are read");
+    assert_eq!(vrm.springs.node_constraints.len(), 3);
+    let sk = &model.skeleton;
+    let joint_of = |node: usize| model.joint_to_node.iter().position(|&n| n == node).unwrap();
+    let mut sim = tassel::CharacterSim::with_vrm(
+        sk.clone(),
+        &tassel::dynamics::RigSettings::default(),
+        &vrm.springs,
+        tassel::dynamics::vrm::VrmOptions::default(),
+    )
+    .unwrap();
+    let axis = Vec3::new(1.0, 2.0, 3.0).normalize();
+    let tau = std::f64::consts::TAU;
+    let (mut worst_pos, mut worst_angle) = (0.0f64, 0.0f64);
+    // How far each destination (nodes 5, 3, 4) turns from its rest: the constraints act.
+    let mut turned = [0.0f32; 3];
+    for f in 1..=frames {
+        let t = f as f64 * dt;
+        let motion1 = Quat::from_axis_angle(axis, (0.8 * (tau * 0.7 * t).sin()) as f32)
+            * Quat::from_rotation_y((0.5 * (tau * 1.3 * t).sin()) as f32);
+        let motion0 = Quat::from_rotation_z((0.3 * (tau * 0.5 * t).sin()) as f32);
+        let mut locals = sk.rest().to_vec();
+        let (j0, j1) = (joint_of(0), joint_of(1));
+        locals[j1].rotation = sk.rest()[j1].rotation * motion1;
+        locals[j0].rotation = sk.rest()[j0].rotation * motion0;
+        let pose = sim
+            .frame(&locals, tassel::Transform::IDENTITY, dt as f32)
+            .unwrap();
+        for (k, node) in [5, 3, 4].into_iter().enumerate() {
+            let j = joint_of(node);
+            turned[k] = turned[k].max(pose.locals[j].rotation.angle_between(sk.rest()[j].rotation));
+        }
+        let sample = &reference["samples"][f - 1];
+        for node in 0..6 {
+            let m = pose.models[joint_of(node)];
+            let p = &sample["world_pos"][node];
+            let q = &sample["world_quat"][node];
+            let want_p = Vec3::from([0, 1, 2].map(|k| p[k].as_f64().unwrap() as f32));
+            let want_q = Quat::from_array([0, 1, 2, 3].map(|k| q[k].as_f64().unwrap() as f32));
+            worst_pos = worst_pos.max((m.translation - want_p).length() as f64);
+            // The angle between them from the vector part (robust for small angles).
+            let d = (m.rotation.inverse() * want_q).normalize();
+            let angle = 2.0 * Vec3::new(d.x, d.y, d.z).length().min(1.0).asin() as f64;
+            worst_angle = worst_angle.max(angle);
+        }
+    }
+    println!(
+        "node constraints vs three-vrm: worst position {worst_pos:.2e} m, worst rotation {worst_angle:.2e} rad over {frames} frames"
+    );
+    println!("destinations turned up to {turned:?} rad from their rest");
+    assert!(
+        turned.iter().all(|&a| a > 0.1),
+        "a constraint did not act: {turned:?}"
+    );
+    assert!(worst_pos <= 1e-4, "{worst_pos} m");
+    assert!(worst_angle <= 1e-4, "{worst_angle} rad");
+}

@@ -4,7 +4,8 @@
 use glam::Vec3;
 use serde_json::Value;
 use tassel::dynamics::vrm::{
-    VrmCollider, VrmColliderGroup, VrmJoint, VrmShape, VrmSpring, VrmSpringBones, VrmTail,
+    ConstraintKind, NodeConstraint, VrmCollider, VrmColliderGroup, VrmJoint, VrmShape, VrmSpring,
+    VrmSpringBones, VrmTail,
 };
 
 /// Which VRM spring-bone definition a file carries.
@@ -37,21 +38,108 @@ pub fn read_spring_bones(
     warnings: &mut Vec<String>,
 ) -> Result<Option<VrmInfo>, String> {
     let ext = &json["extensions"];
+    let constraints = read_node_constraints(json, node_to_joint, warnings)?;
+    let with = |mut springs: VrmSpringBones, version| {
+        springs.node_constraints = constraints.clone();
+        Some(VrmInfo { version, springs })
+    };
     if let Some(sb) = ext.get("VRMC_springBone") {
         let springs = read_v1(sb, json, node_to_joint, warnings)?;
-        return Ok(Some(VrmInfo {
-            version: VrmVersion::V1,
-            springs,
-        }));
+        return Ok(with(springs, VrmVersion::V1));
     }
     if let Some(sa) = ext.get("VRM").and_then(|v| v.get("secondaryAnimation")) {
         let springs = read_v0(sa, json, node_to_joint, warnings)?;
-        return Ok(Some(VrmInfo {
-            version: VrmVersion::V0,
-            springs,
-        }));
+        return Ok(with(springs, VrmVersion::V0));
+    }
+    if !constraints.is_empty() {
+        return Ok(with(VrmSpringBones::default(), VrmVersion::V1));
     }
     Ok(None)
+}
+
+/// `VRMC_node_constraint` 1.0 on the nodes (read when `extensionsUsed` lists it, as
+/// three-vrm does): roll, aim or rotation, the first present in that order; an unknown
+/// `specVersion` is skipped with a warning, as three-vrm skips it.
+fn read_node_constraints(
+    json: &Value,
+    node_to_joint: &[usize],
+    warnings: &mut Vec<String>,
+) -> Result<Vec<NodeConstraint>, String> {
+    const NAME: &str = "VRMC_node_constraint";
+    let used = json["extensionsUsed"]
+        .as_array()
+        .is_some_and(|a| a.iter().any(|e| e == NAME));
+    if !used {
+        return Ok(vec![]);
+    }
+    let nodes = node_count(json);
+    let mut out = vec![];
+    for (n, node) in array(json, "nodes", "glTF")?.iter().enumerate() {
+        let Some(ext) = node.get("extensions").and_then(|e| e.get(NAME)) else {
+            continue;
+        };
+        let at = format!("nodes[{n}].extensions.{NAME}");
+        match ext["specVersion"].as_str() {
+            Some("1.0" | "1.0-beta") => {}
+            other => {
+                warnings.push(format!(
+                    "{at}: specVersion {other:?} is not 1.0: the constraint is ignored"
+                ));
+                continue;
+            }
+        }
+        let c = &ext["constraint"];
+        let axis_of = |name: &str, at: &str| -> Result<Vec3, String> {
+            Ok(match name {
+                "X" | "PositiveX" => Vec3::X,
+                "Y" | "PositiveY" => Vec3::Y,
+                "Z" | "PositiveZ" => Vec3::Z,
+                "NegativeX" => Vec3::NEG_X,
+                "NegativeY" => Vec3::NEG_Y,
+                "NegativeZ" => Vec3::NEG_Z,
+                other => return Err(format!("{at}: unknown axis {other:?}")),
+            })
+        };
+        let (def, kind, cat) = if let Some(r) = c.get("roll").filter(|v| !v.is_null()) {
+            let cat = format!("{at}.constraint.roll");
+            let name = r["rollAxis"].as_str().unwrap_or("X");
+            if !matches!(name, "X" | "Y" | "Z") {
+                return Err(format!("{cat}.rollAxis must be X, Y or Z, not {name:?}"));
+            }
+            let axis = axis_of(name, &cat)?;
+            (r, ConstraintKind::Roll { axis }, cat)
+        } else if let Some(a) = c.get("aim").filter(|v| !v.is_null()) {
+            let cat = format!("{at}.constraint.aim");
+            let axis = axis_of(a["aimAxis"].as_str().unwrap_or("PositiveX"), &cat)?;
+            (a, ConstraintKind::Aim { axis }, cat)
+        } else if let Some(r) = c.get("rotation").filter(|v| !v.is_null()) {
+            (
+                r,
+                ConstraintKind::Rotation,
+                format!("{at}.constraint.rotation"),
+            )
+        } else {
+            warnings.push(format!(
+                "{at}: no roll, aim or rotation constraint; ignored"
+            ));
+            continue;
+        };
+        let source = index(&def["source"], &format!("{cat}.source"), nodes, "node")?;
+        let weight = number(def, "weight", &cat, 1.0)?;
+        if !(0.0..=1.0).contains(&weight) {
+            return Err(format!("{cat}.weight {weight} must be in 0..=1"));
+        }
+        if source == n {
+            return Err(format!("{cat}.source is the node itself"));
+        }
+        out.push(NodeConstraint {
+            destination: node_to_joint[n],
+            source: node_to_joint[source],
+            kind,
+            weight,
+        });
+    }
+    Ok(out)
 }
 
 fn array<'a>(v: &'a Value, key: &str, at: &str) -> Result<&'a [Value], String> {

@@ -776,3 +776,68 @@ fn fixed_mode_on_every_file_within_1_percent_across_frame_rates() {
     }
     assert!(failures.is_empty(), "over 1 %: {}", failures.join(", "));
 }
+
+/// VRMC_node_constraint: read from the nodes (the first of roll, aim, rotation), with
+/// UniVRM's defaults (weight 1, roll about X, aim along +X); bad entries are errors that
+/// name them; an unknown specVersion is skipped with a warning.
+#[test]
+fn node_constraints_are_read_and_bad_ones_named() {
+    use tassel::dynamics::vrm::ConstraintKind;
+    if testdata("vrm").is_none() {
+        return;
+    }
+    let with = |ext: Value| {
+        edited(|j| {
+            j["extensionsUsed"] = serde_json::json!(["VRMC_springBone", "VRMC_node_constraint"]);
+            j["nodes"][5]["extensions"] = serde_json::json!({ "VRMC_node_constraint": ext });
+        })
+    };
+    let ok = with(serde_json::json!({"specVersion": "1.0", "constraint": {"roll": {"source": 1}}}))
+        .unwrap();
+    let c = ok.vrm.as_ref().unwrap().springs.node_constraints[0];
+    assert_eq!(ok.joint_to_node[c.destination], 5);
+    assert_eq!(ok.joint_to_node[c.source], 1);
+    assert_eq!(c.kind, ConstraintKind::Roll { axis: Vec3::X });
+    assert_eq!(c.weight, 1.0);
+    let aim = with(serde_json::json!({"specVersion": "1.0", "constraint": {"aim": {"source": 2, "aimAxis": "NegativeZ", "weight": 0.25}}}))
+        .unwrap();
+    let c = aim.vrm.as_ref().unwrap().springs.node_constraints[0];
+    assert_eq!(c.kind, ConstraintKind::Aim { axis: Vec3::NEG_Z });
+    assert_eq!(c.weight, 0.25);
+    for (ext, says) in [
+        (
+            serde_json::json!({"specVersion": "1.0", "constraint": {"roll": {"source": 99}}}),
+            "node 99",
+        ),
+        (
+            serde_json::json!({"specVersion": "1.0", "constraint": {"roll": {"source": 1, "rollAxis": "W"}}}),
+            "rollAxis",
+        ),
+        (
+            serde_json::json!({"specVersion": "1.0", "constraint": {"aim": {"source": 1, "aimAxis": "Up"}}}),
+            "axis",
+        ),
+        (
+            serde_json::json!({"specVersion": "1.0", "constraint": {"rotation": {"source": 1, "weight": 1.5}}}),
+            "weight",
+        ),
+        (
+            serde_json::json!({"specVersion": "1.0", "constraint": {"rotation": {"source": 5}}}),
+            "itself",
+        ),
+    ] {
+        let e = with(ext).expect_err(says);
+        assert!(e.contains(says) && e.contains("nodes[5]"), "{e}");
+    }
+    let skipped =
+        with(serde_json::json!({"specVersion": "2.0", "constraint": {"roll": {"source": 1}}}))
+            .unwrap();
+    assert!(skipped
+        .vrm
+        .as_ref()
+        .unwrap()
+        .springs
+        .node_constraints
+        .is_empty());
+    assert!(skipped.warnings.iter().any(|w| w.contains("specVersion")));
+}

@@ -280,6 +280,7 @@ fn degenerate_vrm(mode: VrmMode) -> (CharacterSim, Vec<usize>) {
             collider_groups: vec![0],
             center: None,
         }],
+        ..Default::default()
     };
     let options = VrmOptions {
         mode,

@@ -93,6 +93,7 @@ fn spec_mode_matches_the_equations_worked_by_hand() {
             colliders: vec![0],
         }],
         springs: vec![spring(joint, vec![0])],
+        ..Default::default()
     };
     let mut run = Run::new(one_joint(), &bones, VrmOptions::default());
     // The character: still in frames 0 and 1, then 0.1 m along +Z per frame.
@@ -449,6 +450,7 @@ fn a_collider_listed_twice_acts_twice() {
             },
             vec![0, 1, 0],
         )],
+        ..Default::default()
     };
     let rig = VrmRig::new(&one_joint(), &bones, VrmOptions::default()).unwrap();
     let range = rig.links[0].colliders.clone();

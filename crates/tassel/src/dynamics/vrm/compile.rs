@@ -54,6 +54,8 @@ pub struct VrmRig {
     pub link_colliders: Vec<usize>,
     /// Solver options.
     pub options: VrmOptions,
+    /// The file's node constraints, in evaluation order.
+    pub(crate) constraints: super::constraint::CompiledConstraints,
     joint_count: usize,
 }
 
@@ -110,6 +112,10 @@ impl VrmRig {
             colliders: bones.colliders.iter().map(|c| (c.joint, c.shape)).collect(),
             link_colliders,
             options,
+            constraints: super::constraint::CompiledConstraints::new(
+                skeleton,
+                &bones.node_constraints,
+            )?,
             joint_count: skeleton.len(),
         })
     }
@@ -121,11 +127,15 @@ impl VrmRig {
 
     /// True when nothing is simulated.
     pub fn is_empty(&self) -> bool {
-        self.links.is_empty()
+        self.links.is_empty() && self.constraints.list.is_empty()
     }
 
-    /// The simulated joints in processing order.
+    /// The joints the rig writes: the springs' joints in processing order, then the node
+    /// constraints' destinations in evaluation order.
     pub fn simulated_joints(&self) -> impl Iterator<Item = usize> + '_ {
-        self.links.iter().map(|l| l.joint)
+        self.links
+            .iter()
+            .map(|l| l.joint)
+            .chain(self.constraints.list.iter().map(|c| c.0.destination))
     }
 }

@@ -174,6 +174,10 @@ impl VrmJob<'_> {
             locals,
             models,
         } = self;
+        // Node constraints first: the springs see the constrained pose.
+        if !rig.constraints.list.is_empty() {
+            rig.constraints.apply(skeleton, &component, locals, models);
+        }
         if rig.links.is_empty() {
             return Ok(());
         }

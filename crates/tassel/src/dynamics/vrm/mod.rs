@@ -53,11 +53,13 @@
 
 mod collide;
 mod compile;
+mod constraint;
 mod job;
 mod settings;
 
 pub use collide::PlacedVrmCollider;
 pub use compile::{VrmLink, VrmRig};
+pub use constraint::{ConstraintKind, NodeConstraint};
 pub use job::{VrmJob, VrmState};
 pub use settings::{
     VrmCollider, VrmColliderGroup, VrmJoint, VrmMode, VrmOptions, VrmShape, VrmSpring,

@@ -6,6 +6,8 @@ use crate::skeleton::Skeleton;
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
+use super::constraint::NodeConstraint;
+
 /// All spring bones of one model (`VRMC_springBone` 1.0 or VRM 0.x `secondaryAnimation`).
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct VrmSpringBones {
@@ -15,6 +17,10 @@ pub struct VrmSpringBones {
     pub collider_groups: Vec<VrmColliderGroup>,
     /// The springs.
     pub springs: Vec<VrmSpring>,
+    /// The file's `VRMC_node_constraint` constraints, evaluated on the animated pose
+    /// before the springs.
+    #[serde(default)]
+    pub node_constraints: Vec<NodeConstraint>,
 }
 
 /// A collider attached to a joint.
@@ -127,7 +133,7 @@ impl Default for VrmJoint {
 impl VrmSpringBones {
     /// True when there is no spring.
     pub fn is_empty(&self) -> bool {
-        self.springs.iter().all(|s| s.joints.is_empty())
+        self.springs.iter().all(|s| s.joints.is_empty()) && self.node_constraints.is_empty()
     }
 
     /// Every simulated joint, spring by spring.
