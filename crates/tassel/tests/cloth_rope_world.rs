@@ -4,7 +4,10 @@
 
 use glam::{Quat, Vec3};
 use std::sync::Arc;
-use tassel::controller::{Level, LevelCollider, LevelShape};
+use tassel::controller::Level;
+
+mod common;
+use common::line;
 use tassel::dynamics::cloth::ClothSettings;
 use tassel::dynamics::particles::ParticleSettings;
 use tassel::dynamics::rope::RopeSettings;
@@ -38,10 +41,6 @@ fn curtain(anchor: Vec3, dir: Vec3) -> Skeleton {
         }
     }
     Skeleton::new(names, parents, rest).unwrap()
-}
-
-fn boxed(name: &str, centre: Vec3, half: Vec3) -> LevelCollider {
-    LevelCollider::new(name, LevelShape::Box { half_extents: half }, centre)
 }
 
 fn sim(sk: &Skeleton, cloth: ClothSettings, level: &Arc<Level>) -> CharacterSim {
@@ -88,14 +87,7 @@ fn a_curtain_dragged_across_the_floor_never_goes_below_it() {
     // A 0.5 m curtain (4 bones below the bar's row and a virtual tip) from a bar 0.35 m up,
     // starting back and down above the floor: it falls, and its lower part must lie on
     // the floor. The character walks at 2 m/s, turns and stops.
-    let floor = Arc::new(
-        Level::new(vec![boxed(
-            "floor",
-            Vec3::new(0.0, -0.5, 0.0),
-            Vec3::new(50.0, 0.5, 50.0),
-        )])
-        .unwrap(),
-    );
+    let floor = common::floor();
     let sk = curtain(Vec3::new(0.0, 0.35, 0.0), Vec3::new(0.0, -0.6, -0.8));
     let radius = 0.02;
     for hz in [30.0f32, 60.0, 144.0] {
@@ -111,16 +103,7 @@ fn a_curtain_dragged_across_the_floor_never_goes_below_it() {
         let rest = sk.rest().to_vec();
         let (mut lowest, mut lowest_bone, mut touching) = (f32::MAX, f32::MAX, 0);
         for f in 0..(4.0 * hz) as usize {
-            let t = f as f32 / hz;
-            let yaw = if t > 1.5 {
-                0.8 * (t - 1.5).min(1.0)
-            } else {
-                0.0
-            };
-            let comp = Transform::from_translation_rotation(
-                Vec3::new(0.0, 0.0, 2.0 * t.min(3.0)),
-                Quat::from_rotation_y(yaw),
-            );
+            let comp = common::drag_walk(f as f32 / hz);
             s.frame(&rest, comp, if f == 0 { 0.0 } else { 1.0 / hz })
                 .unwrap();
             for p in cloth_points(&s) {
@@ -149,67 +132,6 @@ fn a_curtain_dragged_across_the_floor_never_goes_below_it() {
             "{hz} Hz: the curtain never lay on the floor"
         );
     }
-}
-
-#[test]
-fn a_cloth_flung_at_a_thin_wall_never_passes_it() {
-    // The curtain hangs from a bar 1 m up. The character runs at 10 m/s for 0.1 s and
-    // stops 0.2 m before a 5 cm wall: the cloth, left behind by the start, swings ahead
-    // with the run's momentum into the wall.
-    let wall_near = 1.2;
-    let wall = Arc::new(
-        Level::new(vec![boxed(
-            "wall",
-            Vec3::new(0.0, 0.0, wall_near + 0.025),
-            Vec3::new(2.0, 2.0, 0.025),
-        )])
-        .unwrap(),
-    );
-    let sk = curtain(Vec3::new(0.0, 1.0, 0.0), Vec3::NEG_Y);
-    let radius = 0.01;
-    let mut passed_without = false;
-    for world_collision in [true, false] {
-        for hz in [30.0f32, 60.0, 144.0] {
-            let mut s = sim(
-                &sk,
-                ClothSettings {
-                    radius,
-                    world_collision,
-                    resistance: 0.0,
-                    ..Default::default()
-                },
-                &wall,
-            );
-            let rest = sk.rest().to_vec();
-            let mut farthest = f32::MIN;
-            for f in 0..(1.5 * hz) as usize {
-                let t = f as f32 / hz;
-                let comp = Transform::from_translation(Vec3::new(0.0, 0.0, 10.0 * t.min(0.1)));
-                s.frame(&rest, comp, if f == 0 { 0.0 } else { 1.0 / hz })
-                    .unwrap();
-                for p in cloth_points(&s) {
-                    farthest = farthest.max(p.z);
-                }
-            }
-            if world_collision {
-                println!("{hz} Hz: farthest cloth point {farthest:.4} m (wall at {wall_near} m)");
-                assert!(
-                    farthest <= wall_near - radius + 1e-4,
-                    "{hz} Hz: a point reached {farthest} m, the wall is at {wall_near}"
-                );
-                assert!(
-                    farthest > wall_near - 0.05,
-                    "{hz} Hz: the cloth never reached the wall"
-                );
-            } else {
-                passed_without |= farthest > wall_near + 0.05;
-            }
-        }
-    }
-    assert!(
-        passed_without,
-        "without world collision the cloth should swing through the wall"
-    );
 }
 
 #[test]
@@ -263,19 +185,6 @@ fn far_from_geometry_the_option_changes_nothing() {
     assert_eq!(run_rope(true), run_rope(false));
 }
 
-/// An anchor and `n` bones of `len` along `dir`.
-fn line(n: usize, len: f32, dir: Vec3, anchor: Vec3) -> Skeleton {
-    let mut names = vec!["anchor".to_string()];
-    let mut parents = vec![None];
-    let mut rest = vec![Transform::from_translation(anchor)];
-    for i in 0..n {
-        names.push(format!("r{i}"));
-        parents.push(Some(i));
-        rest.push(Transform::from_translation(dir * len));
-    }
-    Skeleton::new(names, parents, rest).unwrap()
-}
-
 fn rope_sim(
     sk: &Skeleton,
     n: usize,
@@ -287,7 +196,7 @@ fn rope_sim(
         ropes: vec![RopeSettings {
             name: "rope".into(),
             root: "anchor".into(),
-            end: format!("r{}", n - 1),
+            end: format!("b{}", n - 1),
             world_collision,
             world: ParticleSettings {
                 radius,
@@ -308,14 +217,7 @@ fn rope_sim(
 fn a_rope_dragged_across_the_floor_never_goes_below_it() {
     // A 0.6 m rope from a hand 0.4 m up, starting back and down: it falls, lies on the
     // floor and is dragged while the character walks at 2 m/s, turns and stops.
-    let floor = Arc::new(
-        Level::new(vec![boxed(
-            "floor",
-            Vec3::new(0.0, -0.5, 0.0),
-            Vec3::new(50.0, 0.5, 50.0),
-        )])
-        .unwrap(),
-    );
+    let floor = common::floor();
     let sk = line(
         6,
         0.1,
@@ -328,16 +230,7 @@ fn a_rope_dragged_across_the_floor_never_goes_below_it() {
         let rest = sk.rest().to_vec();
         let (mut lowest, mut lowest_bone, mut touching) = (f32::MAX, f32::MAX, 0);
         for f in 0..(4.0 * hz) as usize {
-            let t = f as f32 / hz;
-            let yaw = if t > 1.5 {
-                0.8 * (t - 1.5).min(1.0)
-            } else {
-                0.0
-            };
-            let comp = Transform::from_translation_rotation(
-                Vec3::new(0.0, 0.0, 2.0 * t.min(3.0)),
-                Quat::from_rotation_y(yaw),
-            );
+            let comp = common::drag_walk(f as f32 / hz);
             s.frame(&rest, comp, if f == 0 { 0.0 } else { 1.0 / hz })
                 .unwrap();
             let world = s.ropes().world(0);
@@ -367,65 +260,6 @@ fn a_rope_dragged_across_the_floor_never_goes_below_it() {
         );
         assert!(touching > 100, "{hz} Hz: the rope never lay on the floor");
     }
-}
-
-#[test]
-fn a_rope_flung_at_a_thin_wall_never_passes_it() {
-    // A 0.5 m rope hangs from a hand 1 m up; the character runs at 10 m/s for 0.1 s and
-    // stops 0.2 m before a 5 cm wall.
-    let wall_near = 1.2;
-    let wall = Arc::new(
-        Level::new(vec![boxed(
-            "wall",
-            Vec3::new(0.0, 0.0, wall_near + 0.025),
-            Vec3::new(2.0, 2.0, 0.025),
-        )])
-        .unwrap(),
-    );
-    let sk = line(5, 0.1, Vec3::NEG_Y, Vec3::new(0.0, 1.0, 0.0));
-    let radius = 0.01;
-    let mut passed_without = false;
-    for world_collision in [true, false] {
-        for hz in [30.0f32, 60.0, 144.0] {
-            let mut s = rope_sim(&sk, 5, world_collision, radius, &wall);
-            let rest = sk.rest().to_vec();
-            let mut farthest = f32::MIN;
-            for f in 0..(1.5 * hz) as usize {
-                let t = f as f32 / hz;
-                let comp = Transform::from_translation(Vec3::new(0.0, 0.0, 10.0 * t.min(0.1)));
-                s.frame(&rest, comp, if f == 0 { 0.0 } else { 1.0 / hz })
-                    .unwrap();
-                let world = s.ropes().world(0);
-                for p in world
-                    .positions()
-                    .iter()
-                    .chain(s.ropes().output_positions(0))
-                {
-                    farthest = farthest.max(p.z);
-                }
-                for b in bones(&s, &comp) {
-                    farthest = farthest.max(b.z - radius);
-                }
-            }
-            if world_collision {
-                println!("rope {hz} Hz: farthest point {farthest:.4} m (wall at {wall_near} m)");
-                assert!(
-                    farthest <= wall_near - radius + 1e-4,
-                    "{hz} Hz: a point reached {farthest} m, the wall is at {wall_near}"
-                );
-                assert!(
-                    farthest > wall_near - 0.05,
-                    "{hz} Hz: the rope never reached the wall"
-                );
-            } else {
-                passed_without |= farthest > wall_near + 0.05;
-            }
-        }
-    }
-    assert!(
-        passed_without,
-        "without world collision the rope should swing through the wall"
-    );
 }
 
 /// The demo run (the controller's level, the built-in rig): the skirt and the charm touch
@@ -491,4 +325,94 @@ fn in_the_demo_the_skirt_and_the_charm_touch_the_wall_and_never_enter_it() {
             );
         }
     }
+}
+
+/// A solver flung at a thin wall: the character runs at 10 m/s for 0.1 s and stops 0.2 m
+/// before a 5 cm wall, the hanging cloth or rope (left behind by the start) swings ahead
+/// with the run's momentum. With world collision no point (`points`, world space) ever
+/// gets nearer the wall than its radius, and it does reach the wall; without it, the
+/// points swing through (so the scene tests something).
+fn flung_at_a_thin_wall(
+    what: &str,
+    radius: f32,
+    make: impl Fn(bool, &Arc<Level>) -> CharacterSim,
+    points: impl Fn(&CharacterSim, &Transform) -> Vec<f32>,
+) {
+    let wall_near = 1.2;
+    let wall = common::thin_wall(wall_near);
+    let mut passed_without = false;
+    for world_collision in [true, false] {
+        for hz in [30.0f32, 60.0, 144.0] {
+            let mut s = make(world_collision, &wall);
+            let rest = s.skeleton().rest().to_vec();
+            let mut farthest = f32::MIN;
+            for f in 0..(1.5 * hz) as usize {
+                let comp = common::flung(f as f32 / hz);
+                s.frame(&rest, comp, if f == 0 { 0.0 } else { 1.0 / hz })
+                    .unwrap();
+                farthest = points(&s, &comp).into_iter().fold(farthest, f32::max);
+            }
+            if world_collision {
+                println!("{what} {hz} Hz: farthest point {farthest:.4} m (wall at {wall_near} m)");
+                assert!(
+                    farthest <= wall_near - radius + 1e-4,
+                    "{what} {hz} Hz: a point reached {farthest} m, the wall is at {wall_near}"
+                );
+                assert!(
+                    farthest > wall_near - 0.05,
+                    "{what} {hz} Hz: never reached the wall"
+                );
+            } else {
+                passed_without |= farthest > wall_near + 0.05;
+            }
+        }
+    }
+    assert!(
+        passed_without,
+        "without world collision the {what} should swing through the wall"
+    );
+}
+
+#[test]
+fn a_cloth_flung_at_a_thin_wall_never_passes_it() {
+    // The curtain hangs from a bar 1 m up.
+    let sk = curtain(Vec3::new(0.0, 1.0, 0.0), Vec3::NEG_Y);
+    let radius = 0.01;
+    flung_at_a_thin_wall(
+        "cloth",
+        radius,
+        |world_collision, wall| {
+            let cloth = ClothSettings {
+                radius,
+                world_collision,
+                resistance: 0.0,
+                ..Default::default()
+            };
+            sim(&sk, cloth, wall)
+        },
+        |s, _| cloth_points(s).iter().map(|p| p.z).collect(),
+    );
+}
+
+#[test]
+fn a_rope_flung_at_a_thin_wall_never_passes_it() {
+    // A 0.5 m rope hangs from a hand 1 m up; its written bones count too.
+    let sk = line(5, 0.1, Vec3::NEG_Y, Vec3::new(0.0, 1.0, 0.0));
+    let radius = 0.01;
+    flung_at_a_thin_wall(
+        "rope",
+        radius,
+        |world_collision, wall| rope_sim(&sk, 5, world_collision, radius, wall),
+        |s, comp| {
+            let world = s.ropes().world(0);
+            let particles = world
+                .positions()
+                .iter()
+                .chain(s.ropes().output_positions(0));
+            particles
+                .map(|p| p.z)
+                .chain(bones(s, comp).iter().map(|b| b.z - radius))
+                .collect()
+        },
+    );
 }

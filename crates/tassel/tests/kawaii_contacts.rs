@@ -33,9 +33,11 @@ use glam::{DQuat, DVec3, Quat, Vec3};
 use tassel::collide::Shape;
 use tassel::dynamics::chain::{ChainSettings, ClassicGravity, TimeMode};
 use tassel::dynamics::{ColliderSettings, RigSettings};
-use tassel::{CharacterSim, Skeleton, Transform};
+use tassel::{CharacterSim, Transform};
 
-const BONES: usize = 6;
+mod common;
+use common::hair::{component, pose, skeleton, BONES};
+
 const TARGET_FPS: f64 = 60.0;
 const DAMPING: f64 = 0.1;
 const STIFFNESS: f64 = 0.05;
@@ -59,48 +61,6 @@ const SPHERE_RADIUS: f64 = 0.07;
 const CAPSULE_CENTER: [f64; 3] = [0.0, 1.33, -0.12];
 const CAPSULE_RADIUS: f64 = 0.05;
 const CAPSULE_LENGTH: f64 = 0.3;
-
-/// Head at 1.6 m; hair from the back of the head, down and back.
-fn pose() -> Vec<DVec3> {
-    let mut p = vec![DVec3::new(0.0, 1.62, -0.1)];
-    for i in 0..BONES {
-        let last = p[i];
-        p.push(last + DVec3::new(0.004 * i as f64, -0.06, -0.015));
-    }
-    p
-}
-
-fn skeleton() -> Skeleton {
-    let p = pose();
-    let mut names = vec!["hair_0".to_string()];
-    let mut parents = vec![None];
-    let mut rest = vec![Transform::from_translation(p[0].as_vec3())];
-    for i in 1..=BONES {
-        names.push(format!("hair_{i}"));
-        parents.push(Some(i - 1));
-        rest.push(Transform::from_translation((p[i] - p[i - 1]).as_vec3()));
-    }
-    Skeleton::new(names, parents, rest).unwrap()
-}
-
-fn component(motion: &str, t: f64) -> (DVec3, DQuat) {
-    match motion {
-        "still" => (DVec3::ZERO, DQuat::IDENTITY),
-        "sway" => (
-            DVec3::new(0.3 * (std::f64::consts::TAU * t).sin(), 0.0, 0.0),
-            DQuat::IDENTITY,
-        ),
-        "step" => (
-            DVec3::new(if t >= 0.5 { 0.2 } else { 0.0 }, 0.0, 0.0),
-            DQuat::IDENTITY,
-        ),
-        "turn" => (
-            DVec3::ZERO,
-            DQuat::from_rotation_y(0.5 * (std::f64::consts::TAU * 0.7 * t).sin()),
-        ),
-        _ => unreachable!(),
-    }
-}
 
 /// Which of docs/rig.md's deliberate differences the port applies.
 #[derive(Clone, Copy, Debug)]

@@ -4,27 +4,13 @@
 
 use glam::Vec3;
 use std::sync::Arc;
-use tassel::controller::{Level, LevelCollider, LevelShape};
+use tassel::controller::Level;
+
+mod common;
+use common::line;
 use tassel::dynamics::chain::{ChainSettings, TimeMode};
 use tassel::dynamics::RigSettings;
 use tassel::{CharacterSim, Skeleton, Transform};
-
-/// An anchor and `n` bones of `len` along `dir`.
-fn line(n: usize, len: f32, dir: Vec3, anchor: Vec3) -> Skeleton {
-    let mut names = vec!["anchor".to_string()];
-    let mut parents = vec![None];
-    let mut rest = vec![Transform::from_translation(anchor)];
-    for i in 0..n {
-        names.push(format!("b{i}"));
-        parents.push(Some(i));
-        rest.push(Transform::from_translation(dir * len));
-    }
-    Skeleton::new(names, parents, rest).unwrap()
-}
-
-fn boxed(name: &str, centre: Vec3, half: Vec3) -> LevelCollider {
-    LevelCollider::new(name, LevelShape::Box { half_extents: half }, centre)
-}
 
 fn sim(sk: &Skeleton, chain: ChainSettings, level: &Arc<Level>) -> CharacterSim {
     let rig = RigSettings {
@@ -54,14 +40,7 @@ fn points(sim: &CharacterSim, comp: &Transform) -> Vec<Vec3> {
 fn a_tail_dragged_along_the_floor_never_goes_below_it() {
     // A 0.8 m tail of 8 bones from a hip 0.3 m up, pointing back and down: it must lie on
     // the floor. The character walks at 2 m/s, turns and stops.
-    let floor = Arc::new(
-        Level::new(vec![boxed(
-            "floor",
-            Vec3::new(0.0, -0.5, 0.0),
-            Vec3::new(50.0, 0.5, 50.0),
-        )])
-        .unwrap(),
-    );
+    let floor = common::floor();
     let sk = line(
         8,
         0.1,
@@ -100,17 +79,7 @@ fn a_tail_dragged_along_the_floor_never_goes_below_it() {
         let mut lowest = f32::MAX;
         let mut touching = 0;
         for f in 0..(4.0 * hz) as usize {
-            let t = f as f32 / hz;
-            let x = 2.0 * t.min(3.0);
-            let yaw = if t > 1.5 {
-                0.8 * (t - 1.5).min(1.0)
-            } else {
-                0.0
-            };
-            let comp = Transform::from_translation_rotation(
-                Vec3::new(0.0, 0.0, x),
-                glam::Quat::from_rotation_y(yaw),
-            );
+            let comp = common::drag_walk(f as f32 / hz);
             s.frame(&rest, comp, if f == 0 { 0.0 } else { 1.0 / hz })
                 .unwrap();
             for p in points(&s, &comp) {
@@ -138,14 +107,7 @@ fn a_chain_flung_at_a_thin_wall_never_passes_it() {
     // stops 0.2 m before a 5 cm wall: the chain, left behind by the start, swings ahead
     // with the run's momentum and meets the wall at up to 10 m/s.
     let wall_near = 1.2;
-    let wall = Arc::new(
-        Level::new(vec![boxed(
-            "wall",
-            Vec3::new(0.0, 0.0, wall_near + 0.025),
-            Vec3::new(2.0, 2.0, 0.025),
-        )])
-        .unwrap(),
-    );
+    let wall = common::thin_wall(wall_near);
     let sk = line(5, 0.1, Vec3::NEG_Y, Vec3::new(0.0, 1.0, 0.0));
     let radius = 0.01;
     let mut passed_without = false;
@@ -181,8 +143,7 @@ fn a_chain_flung_at_a_thin_wall_never_passes_it() {
             let mut fastest = 0.0f32;
             let mut last: Option<Vec<Vec3>> = None;
             for f in 0..(1.5 * hz) as usize {
-                let t = f as f32 / hz;
-                let comp = Transform::from_translation(Vec3::new(0.0, 0.0, 10.0 * t.min(0.1)));
+                let comp = common::flung(f as f32 / hz);
                 s.frame(&rest, comp, if f == 0 { 0.0 } else { 1.0 / hz })
                     .unwrap();
                 let now = points(&s, &comp);
