@@ -22,6 +22,16 @@ pub struct Args {
     /// chains.
     #[arg(long, value_enum)]
     vrm: Option<VrmBenchMode>,
+    /// The built-in character's skirt (one bone cloth, 4 leg capsules) instead.
+    #[arg(long, conflicts_with = "vrm")]
+    cloth: bool,
+    /// A crowd of this many characters, each on its own phase of the motion, advanced
+    /// together every frame (one `CharacterSim` each for now).
+    #[arg(long)]
+    crowd: Option<usize>,
+    /// Threads sharing the crowd (each takes a contiguous batch of characters).
+    #[arg(long, default_value_t = 1)]
+    threads: usize,
 }
 
 #[derive(Clone, Copy, clap::ValueEnum)]
@@ -89,18 +99,37 @@ fn as_vrm(sk: &Skeleton, rig: &RigSettings) -> VrmSpringBones {
     b
 }
 
-pub fn run(a: Args) -> Result<(), String> {
+/// One bench character: the simulation, how many joints it simulates, what it is.
+fn character(a: &Args) -> Result<(CharacterSim, usize, String), String> {
     let (chains, joints, colliders) = (16, 8, 8);
     let (sk, rig) = builtin::bench_character(chains, joints, colliders);
-    let (mut sim, simulated, what) = match a.vrm {
+    if a.cloth {
+        let c = builtin::character();
+        let rig = RigSettings {
+            cloths: c.rig.cloths.clone(),
+            colliders: c.rig.colliders.clone(),
+            ..Default::default()
+        };
+        let sim = CharacterSim::new(c.skeleton, &rig).map_err(|e| e.to_string())?;
+        let cloths = sim.cloths();
+        let free = (0..cloths.point_count())
+            .filter(|&p| !cloths.is_fixed(p))
+            .count();
+        return Ok((
+            sim,
+            free,
+            "the built-in skirt (bone cloth, 4 leg capsules, 120 Hz steps), 60 Hz frames".into(),
+        ));
+    }
+    match a.vrm {
         None => {
-            let sim = CharacterSim::new(sk.clone(), &rig).map_err(|e| e.to_string())?;
+            let sim = CharacterSim::new(sk, &rig).map_err(|e| e.to_string())?;
             let simulated = sim.chains().point_count() - chains; // roots are not simulated
-            (
+            Ok((
                 sim,
                 simulated,
-                "chains, fixed mode 60 Hz, one step per frame".to_string(),
-            )
+                format!("{chains} chains x {joints} joints, {colliders} colliders, chains, fixed mode 60 Hz, one step per frame"),
+            ))
         }
         Some(m) => {
             let bones = as_vrm(&sk, &rig);
@@ -113,26 +142,38 @@ pub fn run(a: Args) -> Result<(), String> {
                 mode,
                 ..Default::default()
             };
-            let sim = CharacterSim::with_vrm(sk.clone(), &RigSettings::default(), &bones, options)
+            let sim = CharacterSim::with_vrm(sk, &RigSettings::default(), &bones, options)
                 .map_err(|e| e.to_string())?;
             let simulated = sim.vrm().links.len();
-            (
+            Ok((
                 sim,
                 simulated,
-                format!("VRM spring bones, {mode:?} mode, 60 Hz frames"),
-            )
+                format!("{chains} chains x {joints} joints, {colliders} colliders, VRM spring bones, {mode:?} mode, 60 Hz frames"),
+            ))
         }
-    };
-    let rest = sk.rest().to_vec();
+    }
+}
+
+/// The bench motion of a character with phase `phase` at frame `f`.
+fn motion(f: usize, phase: f32) -> Transform {
+    let t = f as f32 / 60.0 + phase;
+    Transform::from_translation(glam::Vec3::new((3.0 * t).sin() * 0.5, 0.0, t))
+}
+
+pub fn run(a: Args) -> Result<(), String> {
+    if let Some(n) = a.crowd {
+        return crowd(&a, n);
+    }
+    let (mut sim, simulated, what) = character(&a)?;
+    let rest = sim.skeleton().rest().to_vec();
     let dt = 1.0 / 60.0;
     let mut f = 0usize;
     let mut one_run = |frames: usize| -> Result<f64, String> {
         let start = Instant::now();
         for _ in 0..frames {
             f += 1;
-            let t = f as f32 * dt;
-            let comp = Transform::from_translation(glam::Vec3::new((3.0 * t).sin() * 0.5, 0.0, t));
-            sim.frame(&rest, comp, dt).map_err(|e| e.to_string())?;
+            sim.frame(&rest, motion(f, 0.0), dt)
+                .map_err(|e| e.to_string())?;
         }
         Ok(start.elapsed().as_nanos() as f64 / (frames * simulated) as f64)
     };
@@ -143,7 +184,7 @@ pub fn run(a: Args) -> Result<(), String> {
     }
     samples.sort_by(|x, y| x.total_cmp(y));
     let median = samples[samples.len() / 2];
-    say!("tassel bench: {chains} chains x {joints} joints, {colliders} colliders, {what}, single thread");
+    say!("tassel bench: {what}, single thread");
     say!(
         "  {simulated} simulated joints; median of {} runs x {} frames",
         samples.len(),
@@ -157,6 +198,78 @@ pub fn run(a: Args) -> Result<(), String> {
         "  min {:.1}  max {:.1} ns per joint-step",
         samples[0],
         samples[samples.len() - 1]
+    );
+    Ok(())
+}
+
+/// `--crowd N --threads T`: N characters, each on its own phase, advanced frame by frame;
+/// each thread takes a contiguous batch and all wait for each other at the end of every
+/// frame (as a game's frame would). Prints the wall time per frame and per joint-step
+/// (wall time / (N × joints × frames)), medians over the runs.
+fn crowd(a: &Args, n: usize) -> Result<(), String> {
+    if !(1..=1_000_000).contains(&n) {
+        return Err(format!("--crowd {n} must be 1..=1000000"));
+    }
+    if !(1..=256).contains(&a.threads) {
+        return Err(format!("--threads {} must be 1..=256", a.threads));
+    }
+    let mut sims = Vec::with_capacity(n);
+    let mut joints = 0;
+    let mut what = String::new();
+    for _ in 0..n {
+        let (sim, j, w) = character(a)?;
+        sims.push(sim);
+        (joints, what) = (j, w);
+    }
+    let rest = sims[0].skeleton().rest().to_vec();
+    let threads = a.threads.min(n);
+    let batch = n.div_ceil(threads);
+    let dt = 1.0 / 60.0;
+    let mut first_frame = 0usize;
+    let mut one_run = |sims: &mut [CharacterSim], frames: usize| -> Result<f64, String> {
+        let barrier = std::sync::Barrier::new(threads);
+        let start = Instant::now();
+        let results: Vec<Result<(), String>> = std::thread::scope(|scope| {
+            let handles: Vec<_> = sims
+                .chunks_mut(batch)
+                .enumerate()
+                .map(|(b, chunk)| {
+                    let (barrier, rest) = (&barrier, &rest);
+                    scope.spawn(move || -> Result<(), String> {
+                        for f in first_frame..first_frame + frames {
+                            for (k, sim) in chunk.iter_mut().enumerate() {
+                                let phase = (b * batch + k) as f32 * 0.37;
+                                sim.frame(rest, motion(f, phase), dt)
+                                    .map_err(|e| e.to_string())?;
+                            }
+                            barrier.wait();
+                        }
+                        Ok(())
+                    })
+                })
+                .collect();
+            handles.into_iter().map(|h| h.join().unwrap()).collect()
+        });
+        results.into_iter().collect::<Result<(), String>>()?;
+        first_frame += frames;
+        Ok(start.elapsed().as_secs_f64() / frames as f64)
+    };
+    let frames = a.frames.max(1);
+    one_run(&mut sims, frames / 4 + 1)?; // warm up
+    let mut samples = Vec::new();
+    for _ in 0..a.runs.max(1) {
+        samples.push(one_run(&mut sims, frames)?);
+    }
+    samples.sort_by(|x, y| x.total_cmp(y));
+    let per_frame = samples[samples.len() / 2];
+    say!(
+        "tassel bench --crowd: {what}; median of {} runs x {frames} frames",
+        samples.len()
+    );
+    say!(
+        "crowd: {n} characters x {joints} joints, {threads} threads: {:.3} ms per frame, {:.1} ns per joint-step",
+        per_frame * 1e3,
+        per_frame * 1e9 / (n * joints) as f64
     );
     Ok(())
 }

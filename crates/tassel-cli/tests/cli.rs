@@ -411,6 +411,56 @@ fn inspect_lists_vrm_springs_and_clips() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("cut.glb"));
 }
 
+/// `--crowd N --threads T` ends with the line the crowd figures are read from; `--cloth`
+/// times the built-in skirt's 32 free points; bad counts are refused.
+#[test]
+fn bench_crowd_and_cloth() {
+    let out = tassel()
+        .args([
+            "bench",
+            "--crowd",
+            "3",
+            "--threads",
+            "2",
+            "--frames",
+            "5",
+            "--runs",
+            "1",
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let last = stdout.lines().last().unwrap();
+    assert!(
+        last.starts_with("crowd: 3 characters x 112 joints, 2 threads: ")
+            && last.contains(" ms per frame, ")
+            && last.ends_with(" ns per joint-step"),
+        "{last}"
+    );
+    let out = tassel()
+        .args(["bench", "--cloth", "--frames", "5", "--runs", "1"])
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    assert!(String::from_utf8_lossy(&out.stdout).contains("32 simulated joints"));
+    for bad in [
+        &["--crowd", "0"][..],
+        &["--crowd", "2", "--threads", "0"][..],
+    ] {
+        let out = tassel().arg("bench").args(bad).output().unwrap();
+        assert!(!out.status.success(), "{bad:?}");
+        assert!(
+            String::from_utf8_lossy(&out.stderr).contains("must be"),
+            "{bad:?}"
+        );
+    }
+}
+
 #[test]
 fn bench_runs_chains_and_vrm_springs() {
     for extra in [
