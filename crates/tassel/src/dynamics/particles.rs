@@ -16,7 +16,7 @@
 
 use crate::collide::{PlacedCollider, Shape};
 use crate::controller::Level;
-use crate::dynamics::world::WorldContact;
+use crate::dynamics::world::collide_points;
 use crate::error::{Error, Result};
 use crate::math::{normalize_or, Transform};
 use crate::rng::SplitMix64;
@@ -576,7 +576,16 @@ impl ParticleWorld {
         }
         // The world has the last word of the step (one BVH query around the particles).
         if let Some(level) = level {
-            self.collide_world(level);
+            let (pins, contact, r) = (&self.pin_target, &mut self.contact, self.settings.radius);
+            collide_points(
+                level,
+                &mut self.pos,
+                Some(&self.prev),
+                0..pins.len(),
+                |i| pins[i].is_none(),
+                |_| r,
+                |i, push| contact[i] += push,
+            );
         }
         // Friction once per step: take away part of each touching particle's sliding
         // (tangential) velocity.
@@ -603,40 +612,6 @@ impl ParticleWorld {
         for i in 0..self.pos.len() {
             if !self.pos[i].is_finite() {
                 self.pos[i] = self.prev[i];
-            }
-        }
-    }
-}
-
-impl ParticleWorld {
-    /// Keeps the free particles `radius` out of `level`: swept from each one's position
-    /// at the start of the step, sliding along what it meets.
-    fn collide_world(&mut self, level: &Level) {
-        let r = self.settings.radius;
-        let (mut min, mut max) = (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN));
-        for i in 0..self.pos.len() {
-            if self.pin_target[i].is_none() {
-                min = min.min(self.pos[i]).min(self.prev[i]);
-                max = max.max(self.pos[i]).max(self.prev[i]);
-            }
-        }
-        let world = WorldContact {
-            level,
-            from: Transform::IDENTITY,
-            to: Transform::IDENTITY,
-        };
-        if min.x > max.x || !world.near_box(min, max, r + 1e-3) {
-            return;
-        }
-        for i in 0..self.pos.len() {
-            if self.pin_target[i].is_some() {
-                continue;
-            }
-            let before = self.pos[i];
-            let after = world.resolve(before, self.prev[i], r);
-            if after != before {
-                self.pos[i] = after;
-                self.contact[i] += after - before;
             }
         }
     }

@@ -102,8 +102,6 @@ struct CompiledRope {
 /// one entry per bone).
 #[derive(Debug, Clone, Default)]
 struct RopeState {
-    /// The animated bone positions at the end of the last frame.
-    prev_anim: Vec<Vec3>,
     /// This frame's animated bone positions.
     anim: Vec<Vec3>,
     /// The same in the character's space, now and at the last frame's end (the steps
@@ -119,8 +117,7 @@ struct RopeState {
     dev_before: Vec<Vec3>,
     /// The output: the interpolated offsets hung from this frame's animated root.
     out: Vec<Vec3>,
-    /// Colliders at the end of the last frame and now.
-    prev_colliders: Vec<PlacedCollider>,
+    /// This frame's colliders (world space), for the output.
     colliders: Vec<PlacedCollider>,
     /// Time not yet stepped, seconds (< one step).
     accumulator: f32,
@@ -196,7 +193,6 @@ impl Ropes {
             world.pin(ids[0], rest.models[bones[0]].translation)?;
             let n = bones.len();
             out.states.push(RopeState {
-                prev_anim: vec![Vec3::ZERO; n],
                 anim: vec![Vec3::ZERO; n],
                 model_anim: vec![Vec3::ZERO; n],
                 prev_model_anim: vec![Vec3::ZERO; n],
@@ -205,7 +201,6 @@ impl Ropes {
                 dev: vec![Vec3::ZERO; n],
                 dev_before: vec![Vec3::ZERO; n],
                 out: vec![Vec3::ZERO; n],
-                prev_colliders: Vec::with_capacity(colliders.len()),
                 colliders: Vec::with_capacity(colliders.len()),
                 accumulator: 0.0,
             });
@@ -317,9 +312,7 @@ impl Ropes {
                 for k in 0..rope.bones.len() {
                     world.set_position(k, st.anim[k]);
                 }
-                st.prev_anim.copy_from_slice(&st.anim);
                 st.prev_model_anim.copy_from_slice(&st.model_anim);
-                st.prev_colliders.clone_from(&st.colliders);
                 st.prev_colliders_cs.clone_from(&st.colliders_cs);
                 for k in 0..rope.bones.len() {
                     st.dev[k] = st.anim[k] - st.anim[0];
@@ -399,9 +392,7 @@ impl Ropes {
                 }
                 st.out[k] = x;
             }
-            st.prev_anim.copy_from_slice(&st.anim);
             st.prev_model_anim.copy_from_slice(&st.model_anim);
-            std::mem::swap(&mut st.prev_colliders, &mut st.colliders);
             std::mem::swap(&mut st.prev_colliders_cs, &mut st.colliders_cs);
             // Write-back: each bone turns so its child bone points at the child's output
             // position; directions come from the animated models (positions are not

@@ -70,3 +70,47 @@ pub(crate) fn push_out(level: &Level, mut p: Vec3, r: f32) -> Vec3 {
     }
     p
 }
+
+/// The world-space points `points` of a solver whose `free(i)` holds, each `radius(i)`,
+/// kept out of `level`: one BVH query around their bounds (now and at the step's start,
+/// `prev`; none when `prev` is `None`), then each point swept from `prev` and sliding
+/// (or, without `prev`, pushed out). `moved(i, push)` is told of every point that moved.
+pub(crate) fn collide_points(
+    level: &Level,
+    pos: &mut [Vec3],
+    prev: Option<&[Vec3]>,
+    points: std::ops::Range<usize>,
+    free: impl Fn(usize) -> bool,
+    radius: impl Fn(usize) -> f32,
+    mut moved: impl FnMut(usize, Vec3),
+) {
+    let (mut min, mut max, mut r) = (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN), 0.0f32);
+    for i in points.clone().filter(|&i| free(i)) {
+        min = min.min(pos[i]);
+        max = max.max(pos[i]);
+        if let Some(prev) = prev {
+            min = min.min(prev[i]);
+            max = max.max(prev[i]);
+        }
+        r = r.max(radius(i));
+    }
+    let world = WorldContact {
+        level,
+        from: Transform::IDENTITY,
+        to: Transform::IDENTITY,
+    };
+    if min.x > max.x || !world.near_box(min, max, r + 1e-3) {
+        return;
+    }
+    for i in points.filter(|&i| free(i)) {
+        let before = pos[i];
+        let after = match prev {
+            Some(prev) => world.resolve(before, prev[i], radius(i)),
+            None => push_out(level, before, radius(i)),
+        };
+        if after != before {
+            pos[i] = after;
+            moved(i, after - before);
+        }
+    }
+}

@@ -5,7 +5,7 @@ use super::contact::{core, push_segment, push_triangle};
 use crate::collide::PlacedCollider;
 use crate::controller::Level;
 use crate::dynamics::path::CharacterPath;
-use crate::dynamics::world::{push_out, WorldContact};
+use crate::dynamics::world::collide_points;
 use crate::error::{Error, Result};
 use crate::math::{normalize_or, rotation_arc, Transform};
 use crate::rng::SplitMix64;
@@ -22,7 +22,6 @@ pub struct ClothState {
     dev_before: Vec<Vec3>,
     friction: Vec<f32>,
     targets: Vec<Vec3>,
-    prev_targets: Vec<Vec3>,
     step_targets: Vec<Vec3>,
     model_targets: Vec<Vec3>,
     prev_model_targets: Vec<Vec3>,
@@ -35,7 +34,6 @@ pub struct ClothState {
     out_world: Vec<Vec3>,
     out: Vec<Vec3>,
     colliders: Vec<PlacedCollider>,
-    prev_colliders: Vec<PlacedCollider>,
     step_colliders: Vec<PlacedCollider>,
     sides: Vec<Vec<i8>>,
     prev_component: Transform,
@@ -61,7 +59,6 @@ impl ClothState {
             dev_before: vec![Vec3::ZERO; n],
             friction: vec![0.0; n],
             targets: vec![Vec3::ZERO; n],
-            prev_targets: vec![Vec3::ZERO; n],
             step_targets: vec![Vec3::ZERO; n],
             model_targets: vec![Vec3::ZERO; n],
             prev_model_targets: vec![Vec3::ZERO; n],
@@ -71,7 +68,6 @@ impl ClothState {
             out_world: vec![Vec3::ZERO; n],
             out: vec![Vec3::ZERO; n],
             colliders: vec![placed; m],
-            prev_colliders: vec![placed; m],
             step_colliders: vec![placed; m],
             sides: rig
                 .cloths
@@ -187,11 +183,9 @@ impl ClothJob<'_> {
             let level = level.filter(|_| rig.cloths[ci].settings.world_collision);
             run_cloth(rig, ci, state, &component, dt, level);
         }
-        state.prev_targets.copy_from_slice(&state.targets);
         state
             .prev_model_targets
             .copy_from_slice(&state.model_targets);
-        state.prev_colliders.copy_from_slice(&state.colliders);
         state.prev_colliders_cs.copy_from_slice(&state.colliders_cs);
         state.prev_component = component;
         write_back(skeleton, rig, state, locals, models);
@@ -235,13 +229,11 @@ fn reset_cloth(rig: &ClothRig, ci: usize, state: &mut ClothState) {
     for p in rig.cloths[ci].points.clone() {
         state.pos[p] = state.targets[p];
         state.prev[p] = state.targets[p];
-        state.prev_targets[p] = state.targets[p];
         state.prev_model_targets[p] = state.model_targets[p];
         state.dev[p] = Vec3::ZERO;
         state.dev_before[p] = Vec3::ZERO;
         state.friction[p] = 0.0;
     }
-    state.prev_colliders.copy_from_slice(&state.colliders);
     state.prev_colliders_cs.copy_from_slice(&state.colliders_cs);
     state.sides[ci].iter_mut().for_each(|s| *s = 0);
     state.accumulator[ci] = 0.0;
@@ -331,7 +323,6 @@ fn run_cloth(
     if s.force_length_limit {
         limit_lengths(rig, ci, &mut state.out_world, None);
     }
-    let world = level.and_then(|level| near_world(rig, ci, level, &state.out_world, None));
     for _ in 0..3 {
         let mut touched = collide(
             rig,
@@ -342,14 +333,12 @@ fn run_cloth(
             None,
             false,
         );
-        if let Some(world) = &world {
-            for p in cloth.points.clone() {
-                if !rig.fixed[p] {
-                    let out = push_out(world.level, state.out_world[p], rig.radius[p]);
-                    touched |= out != state.out_world[p];
-                    state.out_world[p] = out;
-                }
-            }
+        if let Some(level) = level {
+            let (free, radius) = (|p: usize| !rig.fixed[p], |p: usize| rig.radius[p]);
+            let (out, points) = (&mut state.out_world, cloth.points.clone());
+            collide_points(level, out, None, points, free, radius, |_, _| {
+                touched = true
+            });
         }
         if !touched {
             break;
@@ -359,37 +348,6 @@ fn run_cloth(
     for p in cloth.points.clone() {
         state.out[p] = inv.transform_point(state.out_world[p]);
     }
-}
-
-/// The world for cloth `ci` when some level geometry lies within its points' bounds
-/// (`pos`, and `prev` when given) grown by their largest radius: one BVH query.
-fn near_world<'a>(
-    rig: &ClothRig,
-    ci: usize,
-    level: &'a Level,
-    pos: &[Vec3],
-    prev: Option<&[Vec3]>,
-) -> Option<WorldContact<'a>> {
-    let cloth = &rig.cloths[ci];
-    let (mut min, mut max, mut r) = (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN), 0.0f32);
-    for p in cloth.points.clone() {
-        if rig.fixed[p] {
-            continue;
-        }
-        min = min.min(pos[p]);
-        max = max.max(pos[p]);
-        if let Some(prev) = prev {
-            min = min.min(prev[p]);
-            max = max.max(prev[p]);
-        }
-        r = r.max(rig.radius[p]);
-    }
-    let world = WorldContact {
-        level,
-        from: Transform::IDENTITY,
-        to: Transform::IDENTITY,
-    };
-    (min.x <= max.x && world.near_box(min, max, r + 1e-3)).then_some(world)
 }
 
 /// One fixed step of cloth `ci` with `state.step_targets` and `state.step_colliders`.
@@ -484,19 +442,22 @@ fn step(rig: &ClothRig, ci: usize, state: &mut ClothState, h: f32, level: Option
     }
     // The world has the last word of the step: swept from where each point started it,
     // sliding; a point that touched loses the cloth's friction on the next step.
-    if let Some(world) =
-        level.and_then(|level| near_world(rig, ci, level, &state.pos, Some(&state.prev)))
-    {
-        for p in cloth.points.clone() {
-            if rig.fixed[p] {
-                continue;
-            }
-            let x = world.resolve(state.pos[p], state.prev[p], rig.radius[p]);
-            if x != state.pos[p] {
-                state.pos[p] = x;
-                state.friction[p] = state.friction[p].max(rig.friction[p]);
-            }
-        }
+    if let Some(level) = level {
+        let ClothState {
+            pos,
+            prev,
+            friction,
+            ..
+        } = &mut *state;
+        collide_points(
+            level,
+            pos,
+            Some(prev),
+            cloth.points.clone(),
+            |p| !rig.fixed[p],
+            |p| rig.radius[p],
+            |p, _| friction[p] = friction[p].max(rig.friction[p]),
+        );
     }
 }
 
