@@ -1,13 +1,11 @@
 //! `tassel bench`: ns per joint-step for a synthetic character, single thread.
 
+use std::sync::Arc;
 use std::time::Instant;
-use tassel::collide::Shape;
-use tassel::dynamics::vrm::{
-    VrmCollider, VrmColliderGroup, VrmJoint, VrmMode, VrmOptions, VrmShape, VrmSpring,
-    VrmSpringBones, VrmTail,
-};
+use tassel::crowd::{CrowdPose, VrmCrowd};
+use tassel::dynamics::vrm::{VrmMode, VrmOptions, VrmRig};
 use tassel::dynamics::RigSettings;
-use tassel::{builtin, CharacterSim, Skeleton, Transform};
+use tassel::{builtin, CharacterSim, Transform};
 
 /// Options of `tassel bench`.
 #[derive(clap::Args)]
@@ -26,12 +24,17 @@ pub struct Args {
     #[arg(long, conflicts_with = "vrm")]
     cloth: bool,
     /// A crowd of this many characters, each on its own phase of the motion, advanced
-    /// together every frame (one `CharacterSim` each for now).
+    /// together every frame: VRM springs in spec or three-vrm mode through the crowd path
+    /// (`tassel::crowd`, lane groups of 8), other solvers one `CharacterSim` each.
     #[arg(long)]
     crowd: Option<usize>,
-    /// Threads sharing the crowd (each takes a contiguous batch of characters).
+    /// Threads sharing the crowd.
     #[arg(long, default_value_t = 1)]
     threads: usize,
+    /// With --crowd: also time the single-character path (one `CharacterSim` per
+    /// character, the same threads) in the same run and print the ratio.
+    #[arg(long, requires = "crowd")]
+    compare: bool,
 }
 
 #[derive(Clone, Copy, clap::ValueEnum)]
@@ -39,64 +42,6 @@ enum VrmBenchMode {
     Spec,
     Fixed,
     ThreeVrm,
-}
-
-/// The bench rig's chains and colliders as VRM springs: every non-root chain bone swings
-/// toward its child (the last one toward a virtual tail), colliding with all colliders.
-fn as_vrm(sk: &Skeleton, rig: &RigSettings) -> VrmSpringBones {
-    let mut b = VrmSpringBones::default();
-    for c in &rig.colliders {
-        let joint = sk.find(&c.bone).expect("bench collider bone");
-        let shape = match c.shape {
-            Shape::Sphere { radius, inside } => VrmShape::Sphere {
-                offset: c.offset,
-                radius,
-                inside,
-            },
-            Shape::Capsule { radius, length } => {
-                let axis = c.rotation * glam::Vec3::Y * (0.5 * length);
-                VrmShape::Capsule {
-                    offset: c.offset - axis,
-                    tail: c.offset + axis,
-                    radius,
-                    inside: false,
-                }
-            }
-            _ => continue,
-        };
-        b.colliders.push(VrmCollider { joint, shape });
-    }
-    b.collider_groups.push(VrmColliderGroup {
-        name: "all".into(),
-        colliders: (0..b.colliders.len()).collect(),
-    });
-    for ch in &rig.chains {
-        let root = sk.find(&ch.root).expect("bench chain root");
-        let mut joints = Vec::new();
-        let mut j = sk.children(root).next();
-        while let Some(k) = j {
-            let child = sk.children(k).next();
-            joints.push(VrmJoint {
-                joint: k,
-                tail: match child {
-                    Some(c) => VrmTail::Joint(c),
-                    None => VrmTail::Local(glam::Vec3::new(0.0, -0.07, 0.0)),
-                },
-                hit_radius: 0.02,
-                stiffness: 1.0,
-                gravity_power: 1.0,
-                ..Default::default()
-            });
-            j = child;
-        }
-        b.springs.push(VrmSpring {
-            name: ch.name.clone(),
-            joints,
-            collider_groups: vec![0],
-            center: None,
-        });
-    }
-    b
 }
 
 /// One bench character: the simulation, how many joints it simulates, what it is.
@@ -132,7 +77,7 @@ fn character(a: &Args) -> Result<(CharacterSim, usize, String), String> {
             ))
         }
         Some(m) => {
-            let bones = as_vrm(&sk, &rig);
+            let (_, bones) = builtin::bench_vrm(chains, joints, colliders);
             let mode = match m {
                 VrmBenchMode::Spec => VrmMode::Spec,
                 VrmBenchMode::Fixed => VrmMode::Fixed,
@@ -213,6 +158,104 @@ fn crowd(a: &Args, n: usize) -> Result<(), String> {
     if !(1..=256).contains(&a.threads) {
         return Err(format!("--threads {} must be 1..=256", a.threads));
     }
+    let threads = a.threads.min(n);
+    let frames = a.frames.max(1);
+    let crowd_path = matches!(a.vrm, Some(VrmBenchMode::Spec | VrmBenchMode::ThreeVrm));
+    let reference = if !crowd_path || a.compare {
+        Some(sims_crowd(a, n, threads, frames)?)
+    } else {
+        None
+    };
+    let (what, joints, per_frame, path) = if crowd_path {
+        let (what, joints, t) = vrm_crowd(a, n, threads, frames)?;
+        (what, joints, t, "crowd path")
+    } else {
+        let (what, joints, t) = reference.clone().expect("timed above");
+        (what, joints, t, "one CharacterSim per character")
+    };
+    say!(
+        "tassel bench --crowd: {what}; {path}; median of {} runs x {frames} frames",
+        a.runs.max(1)
+    );
+    if let (true, Some((_, _, r))) = (crowd_path, &reference) {
+        say!(
+            "  single-character path, same run: {:.3} ms per frame, {:.1} ns per joint-step: the crowd path is {:.1}x faster",
+            r * 1e3,
+            r * 1e9 / (n * joints) as f64,
+            r / per_frame
+        );
+    }
+    say!(
+        "crowd: {n} characters x {joints} joints, {threads} threads: {:.3} ms per frame, {:.1} ns per joint-step",
+        per_frame * 1e3,
+        per_frame * 1e9 / (n * joints) as f64
+    );
+    Ok(())
+}
+
+/// The VRM crowd path: seconds per frame (median), with what was run.
+fn vrm_crowd(
+    a: &Args,
+    n: usize,
+    threads: usize,
+    frames: usize,
+) -> Result<(String, usize, f64), String> {
+    let (_, joints, what) = character(a)?;
+    let (sk, bones) = builtin::bench_vrm(16, 8, 8);
+    let mode = match a.vrm {
+        Some(VrmBenchMode::ThreeVrm) => VrmMode::ThreeVrm,
+        _ => VrmMode::Spec,
+    };
+    let options = VrmOptions {
+        mode,
+        ..Default::default()
+    };
+    let rig = VrmRig::new(&sk, &bones, options).map_err(|e| e.to_string())?;
+    let rest = sk.rest().to_vec();
+    let mut crowd = VrmCrowd::new(Arc::new(sk), Arc::new(rig)).map_err(|e| e.to_string())?;
+    for _ in 0..n {
+        crowd.add();
+    }
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| e.to_string())?;
+    let dt = 1.0 / 60.0;
+    let mut first_frame = 0usize;
+    let mut one_run = |frames: usize| -> Result<f64, String> {
+        let start = Instant::now();
+        pool.install(|| -> Result<(), String> {
+            for f in first_frame..first_frame + frames {
+                crowd
+                    .frame(dt, |i| CrowdPose {
+                        transform: motion(f, i as f32 * 0.37),
+                        locals: &rest,
+                    })
+                    .map_err(|e| e.to_string())?;
+            }
+            Ok(())
+        })?;
+        first_frame += frames;
+        Ok(start.elapsed().as_secs_f64() / frames as f64)
+    };
+    one_run(frames / 4 + 1)?; // warm up
+    let mut samples = Vec::new();
+    for _ in 0..a.runs.max(1) {
+        samples.push(one_run(frames)?);
+    }
+    samples.sort_by(|x, y| x.total_cmp(y));
+    Ok((what, joints, samples[samples.len() / 2]))
+}
+
+/// The single-character path for a crowd: one `CharacterSim` per character, threads
+/// taking contiguous batches and meeting at the end of every frame. Seconds per frame
+/// (median), with what was run.
+fn sims_crowd(
+    a: &Args,
+    n: usize,
+    threads: usize,
+    frames: usize,
+) -> Result<(String, usize, f64), String> {
     let mut sims = Vec::with_capacity(n);
     let mut joints = 0;
     let mut what = String::new();
@@ -222,7 +265,6 @@ fn crowd(a: &Args, n: usize) -> Result<(), String> {
         (joints, what) = (j, w);
     }
     let rest = sims[0].skeleton().rest().to_vec();
-    let threads = a.threads.min(n);
     let batch = n.div_ceil(threads);
     let dt = 1.0 / 60.0;
     let mut first_frame = 0usize;
@@ -254,22 +296,11 @@ fn crowd(a: &Args, n: usize) -> Result<(), String> {
         first_frame += frames;
         Ok(start.elapsed().as_secs_f64() / frames as f64)
     };
-    let frames = a.frames.max(1);
     one_run(&mut sims, frames / 4 + 1)?; // warm up
     let mut samples = Vec::new();
     for _ in 0..a.runs.max(1) {
         samples.push(one_run(&mut sims, frames)?);
     }
     samples.sort_by(|x, y| x.total_cmp(y));
-    let per_frame = samples[samples.len() / 2];
-    say!(
-        "tassel bench --crowd: {what}; median of {} runs x {frames} frames",
-        samples.len()
-    );
-    say!(
-        "crowd: {n} characters x {joints} joints, {threads} threads: {:.3} ms per frame, {:.1} ns per joint-step",
-        per_frame * 1e3,
-        per_frame * 1e9 / (n * joints) as f64
-    );
-    Ok(())
+    Ok((what, joints, samples[samples.len() / 2]))
 }

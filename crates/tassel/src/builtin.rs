@@ -496,6 +496,73 @@ pub fn bench_character(chains: usize, joints: usize, colliders: usize) -> (Skele
     (b.build().expect("valid bench skeleton").0, rig)
 }
 
+/// The bench character of [`bench_character`] as VRM spring bones: every chain bone below
+/// the chain's first swings toward its child (the last toward a virtual tail 7 cm down),
+/// tail radius 2 cm, stiffness 1, gravity 1, colliding with every collider (one group).
+pub fn bench_vrm(
+    chains: usize,
+    joints: usize,
+    colliders: usize,
+) -> (Skeleton, crate::dynamics::vrm::VrmSpringBones) {
+    use crate::dynamics::vrm::{
+        VrmCollider, VrmColliderGroup, VrmJoint, VrmShape, VrmSpring, VrmSpringBones, VrmTail,
+    };
+    let (sk, rig) = bench_character(chains, joints, colliders);
+    let mut b = VrmSpringBones::default();
+    for c in &rig.colliders {
+        let joint = sk.find(&c.bone).expect("bench collider bone");
+        let shape = match c.shape {
+            Shape::Sphere { radius, inside } => VrmShape::Sphere {
+                offset: c.offset,
+                radius,
+                inside,
+            },
+            Shape::Capsule { radius, length } => {
+                let axis = c.rotation * Vec3::Y * (0.5 * length);
+                VrmShape::Capsule {
+                    offset: c.offset - axis,
+                    tail: c.offset + axis,
+                    radius,
+                    inside: false,
+                }
+            }
+            _ => continue,
+        };
+        b.colliders.push(VrmCollider { joint, shape });
+    }
+    b.collider_groups.push(VrmColliderGroup {
+        name: "all".into(),
+        colliders: (0..b.colliders.len()).collect(),
+    });
+    for ch in &rig.chains {
+        let root = sk.find(&ch.root).expect("bench chain root");
+        let mut joints = Vec::new();
+        let mut j = sk.children(root).next();
+        while let Some(k) = j {
+            let child = sk.children(k).next();
+            joints.push(VrmJoint {
+                joint: k,
+                tail: match child {
+                    Some(c) => VrmTail::Joint(c),
+                    None => VrmTail::Local(Vec3::new(0.0, -0.07, 0.0)),
+                },
+                hit_radius: 0.02,
+                stiffness: 1.0,
+                gravity_power: 1.0,
+                ..Default::default()
+            });
+            j = child;
+        }
+        b.springs.push(VrmSpring {
+            name: ch.name.clone(),
+            joints,
+            collider_groups: vec![0],
+            center: None,
+        });
+    }
+    (sk, b)
+}
+
 /// Builds the embedded character.
 pub fn character() -> Character {
     let skeleton = skeleton();

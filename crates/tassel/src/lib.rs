@@ -18,6 +18,7 @@ pub mod anim;
 pub mod builtin;
 pub mod collide;
 pub mod controller;
+pub mod crowd;
 pub mod dynamics;
 mod error;
 mod instance;

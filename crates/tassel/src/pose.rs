@@ -44,6 +44,11 @@ fn local_to_model(sk: &Skeleton, root: &Transform, locals: &[Transform], models:
     }
 }
 
+/// [`LocalToModelJob`] with the identity above the roots, for buffers already checked.
+pub(crate) fn local_to_model_into(sk: &Skeleton, locals: &[Transform], models: &mut [Transform]) {
+    local_to_model(sk, &Transform::IDENTITY, locals, models);
+}
+
 fn check_len(what: &'static str, expected: usize, got: usize) -> Result<()> {
     if expected == got {
         Ok(())

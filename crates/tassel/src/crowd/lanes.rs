@@ -1,0 +1,687 @@
+//! Lane types for the crowd path: one `f32` per character, [`LANES`] characters side by
+//! side, so that one instruction advances several characters.
+//!
+//! Every operation repeats, lane by lane, the exact sequence of IEEE operations that glam
+//! 0.32 (SSE2 build) and [`crate::math`] perform for one character: the same products,
+//! summed in the same order, the same square roots and divisions. That is what lets the
+//! crowd path give the single-character path's results bit for bit. The per-element loops
+//! are left to the compiler to vectorise (plain stable Rust, no `unsafe`).
+
+use crate::math::Transform;
+use glam::{Quat, Vec3};
+use std::ops::{Add, Div, Mul, Neg, Sub};
+
+/// Characters per lane group.
+pub const LANES: usize = 8;
+
+/// One `f32` per lane.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C, align(32))]
+pub struct F(pub [f32; LANES]);
+
+/// A per-lane condition (all bits set when true).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(C, align(32))]
+pub struct M(pub [u32; LANES]);
+
+macro_rules! lanewise {
+    ($a:expr, $b:expr, $op:tt) => {{
+        let mut r = [0.0f32; LANES];
+        for i in 0..LANES {
+            r[i] = $a.0[i] $op $b.0[i];
+        }
+        F(r)
+    }};
+}
+
+impl Add for F {
+    type Output = F;
+    #[inline(always)]
+    fn add(self, o: F) -> F {
+        lanewise!(self, o, +)
+    }
+}
+impl Sub for F {
+    type Output = F;
+    #[inline(always)]
+    fn sub(self, o: F) -> F {
+        lanewise!(self, o, -)
+    }
+}
+impl Mul for F {
+    type Output = F;
+    #[inline(always)]
+    fn mul(self, o: F) -> F {
+        lanewise!(self, o, *)
+    }
+}
+impl Div for F {
+    type Output = F;
+    #[inline(always)]
+    fn div(self, o: F) -> F {
+        lanewise!(self, o, /)
+    }
+}
+impl Neg for F {
+    type Output = F;
+    #[inline(always)]
+    fn neg(self) -> F {
+        let mut r = [0.0f32; LANES];
+        for i in 0..LANES {
+            r[i] = -self.0[i];
+        }
+        F(r)
+    }
+}
+
+impl F {
+    /// Every lane `v`.
+    #[inline(always)]
+    pub fn splat(v: f32) -> F {
+        F([v; LANES])
+    }
+
+    /// Lane-wise square root.
+    #[inline(always)]
+    pub fn sqrt(self) -> F {
+        let mut r = [0.0f32; LANES];
+        for i in 0..LANES {
+            r[i] = self.0[i].sqrt();
+        }
+        F(r)
+    }
+
+    /// `self < o` per lane.
+    #[inline(always)]
+    pub fn lt(self, o: F) -> M {
+        let mut r = [0u32; LANES];
+        for i in 0..LANES {
+            r[i] = if self.0[i] < o.0[i] { !0 } else { 0 };
+        }
+        M(r)
+    }
+
+    /// `self <= o` per lane.
+    #[inline(always)]
+    pub fn le(self, o: F) -> M {
+        let mut r = [0u32; LANES];
+        for i in 0..LANES {
+            r[i] = if self.0[i] <= o.0[i] { !0 } else { 0 };
+        }
+        M(r)
+    }
+
+    /// `self > o` per lane.
+    #[inline(always)]
+    pub fn gt(self, o: F) -> M {
+        o.lt(self)
+    }
+
+    /// Finite per lane (not NaN, not infinite).
+    #[inline(always)]
+    pub fn finite(self) -> M {
+        let mut r = [0u32; LANES];
+        for i in 0..LANES {
+            r[i] = if (self.0[i].to_bits() & 0x7f80_0000) != 0x7f80_0000 {
+                !0
+            } else {
+                0
+            };
+        }
+        M(r)
+    }
+
+    /// `m ? a : b` per lane.
+    #[inline(always)]
+    pub fn select(m: M, a: F, b: F) -> F {
+        let mut r = [0.0f32; LANES];
+        for i in 0..LANES {
+            r[i] = f32::from_bits((a.0[i].to_bits() & m.0[i]) | (b.0[i].to_bits() & !m.0[i]));
+        }
+        F(r)
+    }
+}
+
+impl M {
+    /// No lane.
+    pub const NONE: M = M([0; LANES]);
+    /// Every lane.
+    pub const ALL: M = M([!0; LANES]);
+
+    /// Both conditions.
+    #[inline(always)]
+    pub fn and(self, o: M) -> M {
+        let mut r = [0u32; LANES];
+        for i in 0..LANES {
+            r[i] = self.0[i] & o.0[i];
+        }
+        M(r)
+    }
+
+    /// Either condition.
+    #[inline(always)]
+    pub fn or(self, o: M) -> M {
+        let mut r = [0u32; LANES];
+        for i in 0..LANES {
+            r[i] = self.0[i] | o.0[i];
+        }
+        M(r)
+    }
+
+    /// The opposite condition.
+    #[inline(always)]
+    #[allow(clippy::should_implement_trait)]
+    pub fn not(self) -> M {
+        let mut r = [0u32; LANES];
+        for i in 0..LANES {
+            r[i] = !self.0[i];
+        }
+        M(r)
+    }
+
+    /// Any lane set.
+    #[inline(always)]
+    pub fn any(self) -> bool {
+        self.0.iter().any(|&b| b != 0)
+    }
+
+    /// Lane `i` set.
+    #[inline(always)]
+    pub fn get(self, i: usize) -> bool {
+        self.0[i] != 0
+    }
+
+    /// From one `bool` per lane.
+    pub fn from_bools(b: [bool; LANES]) -> M {
+        M(b.map(|b| if b { !0 } else { 0 }))
+    }
+}
+
+/// A `Vec3` per lane.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct V3 {
+    /// X per lane.
+    pub x: F,
+    /// Y per lane.
+    pub y: F,
+    /// Z per lane.
+    pub z: F,
+}
+
+impl Add for V3 {
+    type Output = V3;
+    #[inline(always)]
+    fn add(self, o: V3) -> V3 {
+        V3 {
+            x: self.x + o.x,
+            y: self.y + o.y,
+            z: self.z + o.z,
+        }
+    }
+}
+impl Sub for V3 {
+    type Output = V3;
+    #[inline(always)]
+    fn sub(self, o: V3) -> V3 {
+        V3 {
+            x: self.x - o.x,
+            y: self.y - o.y,
+            z: self.z - o.z,
+        }
+    }
+}
+impl Neg for V3 {
+    type Output = V3;
+    #[inline(always)]
+    fn neg(self) -> V3 {
+        V3 {
+            x: -self.x,
+            y: -self.y,
+            z: -self.z,
+        }
+    }
+}
+/// Component-wise product.
+impl Mul for V3 {
+    type Output = V3;
+    #[inline(always)]
+    fn mul(self, o: V3) -> V3 {
+        V3 {
+            x: self.x * o.x,
+            y: self.y * o.y,
+            z: self.z * o.z,
+        }
+    }
+}
+/// Component-wise quotient.
+impl Div for V3 {
+    type Output = V3;
+    #[inline(always)]
+    fn div(self, o: V3) -> V3 {
+        V3 {
+            x: self.x / o.x,
+            y: self.y / o.y,
+            z: self.z / o.z,
+        }
+    }
+}
+impl Mul<F> for V3 {
+    type Output = V3;
+    #[inline(always)]
+    fn mul(self, s: F) -> V3 {
+        V3 {
+            x: self.x * s,
+            y: self.y * s,
+            z: self.z * s,
+        }
+    }
+}
+impl Div<F> for V3 {
+    type Output = V3;
+    #[inline(always)]
+    fn div(self, s: F) -> V3 {
+        V3 {
+            x: self.x / s,
+            y: self.y / s,
+            z: self.z / s,
+        }
+    }
+}
+
+impl V3 {
+    /// Every lane `v`.
+    #[inline(always)]
+    pub fn splat(v: Vec3) -> V3 {
+        V3 {
+            x: F::splat(v.x),
+            y: F::splat(v.y),
+            z: F::splat(v.z),
+        }
+    }
+
+    /// glam's `Vec3::dot`: `(x·x' + y·y') + z·z'`.
+    #[inline(always)]
+    pub fn dot(self, o: V3) -> F {
+        self.x * o.x + self.y * o.y + self.z * o.z
+    }
+
+    /// glam's `Vec3::cross`.
+    #[inline(always)]
+    pub fn cross(self, o: V3) -> V3 {
+        V3 {
+            x: self.y * o.z - o.y * self.z,
+            y: self.z * o.x - o.z * self.x,
+            z: self.x * o.y - o.x * self.y,
+        }
+    }
+
+    /// glam's `Vec3::length`.
+    #[inline(always)]
+    pub fn length(self) -> F {
+        self.dot(self).sqrt()
+    }
+
+    /// [`crate::math::normalize_or`] per lane.
+    #[inline(always)]
+    pub fn normalize_or(self, fallback: V3) -> V3 {
+        let len2 = self.dot(self);
+        let ok = len2.gt(F::splat(1e-20)).and(len2.finite());
+        V3::select(ok, self / len2.sqrt(), fallback)
+    }
+
+    /// `m ? a : b` per lane.
+    #[inline(always)]
+    pub fn select(m: M, a: V3, b: V3) -> V3 {
+        V3 {
+            x: F::select(m, a.x, b.x),
+            y: F::select(m, a.y, b.y),
+            z: F::select(m, a.z, b.z),
+        }
+    }
+
+    /// Finite in every component, per lane.
+    #[inline(always)]
+    pub fn finite(self) -> M {
+        self.x.finite().and(self.y.finite()).and(self.z.finite())
+    }
+
+    /// Lane `i`.
+    #[inline(always)]
+    pub fn get(&self, i: usize) -> Vec3 {
+        Vec3::new(self.x.0[i], self.y.0[i], self.z.0[i])
+    }
+
+    /// Sets lane `i`.
+    #[inline(always)]
+    pub fn set(&mut self, i: usize, v: Vec3) {
+        self.x.0[i] = v.x;
+        self.y.0[i] = v.y;
+        self.z.0[i] = v.z;
+    }
+}
+
+/// A `Quat` per lane.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Q {
+    /// X per lane.
+    pub x: F,
+    /// Y per lane.
+    pub y: F,
+    /// Z per lane.
+    pub z: F,
+    /// W per lane.
+    pub w: F,
+}
+
+impl Q {
+    /// Every lane `q`.
+    #[inline(always)]
+    pub fn splat(q: Quat) -> Q {
+        Q {
+            x: F::splat(q.x),
+            y: F::splat(q.y),
+            z: F::splat(q.z),
+            w: F::splat(q.w),
+        }
+    }
+
+    /// glam's SSE2 `Quat::mul_quat`: `(w·r + x·r_wzyx·±) + (y·r_zwxy·± + z·r_yxwz·±)`.
+    #[inline(always)]
+    pub fn mul_quat(self, r: Q) -> Q {
+        let l = self;
+        // The four partial products, lane by lane as glam's shuffled vectors hold them.
+        let tw = [l.w * r.x, l.w * r.y, l.w * r.z, l.w * r.w];
+        let tx = [l.x * r.w, -(l.x * r.z), l.x * r.y, -(l.x * r.x)];
+        let ty = [l.y * r.z, l.y * r.w, -(l.y * r.x), -(l.y * r.y)];
+        let tz = [-(l.z * r.y), l.z * r.x, l.z * r.w, -(l.z * r.z)];
+        let c = |k: usize| (tw[k] + tx[k]) + (ty[k] + tz[k]);
+        Q {
+            x: c(0),
+            y: c(1),
+            z: c(2),
+            w: c(3),
+        }
+    }
+
+    /// glam's SSE2 `Quat::mul_vec3`:
+    /// `(v·(w² − b·b) + b·(2(v·b))) + (b × v)·(2w)`.
+    #[inline(always)]
+    pub fn mul_vec3(self, v: V3) -> V3 {
+        let b = V3 {
+            x: self.x,
+            y: self.y,
+            z: self.z,
+        };
+        let w = self.w;
+        let two = F::splat(2.0);
+        let k = w * w - b.dot(b);
+        let d2 = v.dot(b) * two;
+        let w2 = w * two;
+        let c = sse_cross(b, v);
+        (v * k + b * d2) + c * w2
+    }
+
+    /// glam's SSE2 `Quat::normalize`: divided by `sqrt((x² + z²) + (y² + w²))`.
+    #[inline(always)]
+    pub fn normalize(self) -> Q {
+        let len = self.dot(self).sqrt();
+        Q {
+            x: self.x / len,
+            y: self.y / len,
+            z: self.z / len,
+            w: self.w / len,
+        }
+    }
+
+    /// glam's SSE2 four-component dot product: `(x·x' + z·z') + (y·y' + w·w')`.
+    #[inline(always)]
+    pub fn dot(self, o: Q) -> F {
+        (self.x * o.x + self.z * o.z) + (self.y * o.y + self.w * o.w)
+    }
+
+    /// The conjugate (the inverse of a unit quaternion).
+    #[inline(always)]
+    pub fn conjugate(self) -> Q {
+        Q {
+            x: -self.x,
+            y: -self.y,
+            z: -self.z,
+            w: self.w,
+        }
+    }
+
+    /// `m ? a : b` per lane.
+    #[inline(always)]
+    pub fn select(m: M, a: Q, b: Q) -> Q {
+        Q {
+            x: F::select(m, a.x, b.x),
+            y: F::select(m, a.y, b.y),
+            z: F::select(m, a.z, b.z),
+            w: F::select(m, a.w, b.w),
+        }
+    }
+
+    /// Finite in every component, per lane.
+    #[inline(always)]
+    pub fn finite(self) -> M {
+        self.x
+            .finite()
+            .and(self.y.finite())
+            .and(self.z.finite())
+            .and(self.w.finite())
+    }
+
+    /// Lane `i`.
+    #[inline(always)]
+    pub fn get(&self, i: usize) -> Quat {
+        Quat::from_xyzw(self.x.0[i], self.y.0[i], self.z.0[i], self.w.0[i])
+    }
+
+    /// Sets lane `i`.
+    #[inline(always)]
+    pub fn set(&mut self, i: usize, q: Quat) {
+        self.x.0[i] = q.x;
+        self.y.0[i] = q.y;
+        self.z.0[i] = q.z;
+        self.w.0[i] = q.w;
+    }
+}
+
+/// glam's SSE2 `Vec3A::cross` (the same products as `Vec3::cross`, so the same bits).
+#[inline(always)]
+fn sse_cross(a: V3, b: V3) -> V3 {
+    V3 {
+        x: a.y * b.z - b.y * a.z,
+        y: a.z * b.x - b.z * a.x,
+        z: a.x * b.y - b.x * a.y,
+    }
+}
+
+/// A [`Transform`] per lane.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Trs {
+    /// Translation.
+    pub t: V3,
+    /// Rotation.
+    pub r: Q,
+    /// Scale.
+    pub s: V3,
+}
+
+impl Trs {
+    /// Every lane `t`.
+    #[inline(always)]
+    pub fn splat(t: &Transform) -> Trs {
+        Trs {
+            t: V3::splat(t.translation),
+            r: Q::splat(t.rotation),
+            s: V3::splat(t.scale),
+        }
+    }
+
+    /// [`Transform::transform_point`].
+    #[inline(always)]
+    pub fn transform_point(&self, p: V3) -> V3 {
+        self.t + self.r.mul_vec3(self.s * p)
+    }
+
+    /// [`Transform::inverse_transform_point`].
+    #[inline(always)]
+    pub fn inverse_transform_point(&self, p: V3) -> V3 {
+        self.r.conjugate().mul_vec3(p - self.t) / self.s
+    }
+
+    /// [`Transform::mul_transform`]: `self * child`.
+    #[inline(always)]
+    pub fn mul(&self, child: &Trs) -> Trs {
+        Trs {
+            t: self.transform_point(child.t),
+            r: self.r.mul_quat(child.r).normalize(),
+            s: self.s * child.s,
+        }
+    }
+
+    /// Lane `i`.
+    #[inline(always)]
+    pub fn get(&self, i: usize) -> Transform {
+        Transform::new(self.t.get(i), self.r.get(i), self.s.get(i))
+    }
+
+    /// Sets lane `i`.
+    #[inline(always)]
+    pub fn set(&mut self, i: usize, t: &Transform) {
+        self.t.set(i, t.translation);
+        self.r.set(i, t.rotation);
+        self.s.set(i, t.scale);
+    }
+}
+
+/// [`crate::math::rotation_arc`] per lane from a direction shared by all lanes: `a` is
+/// `normalize_or(from, Y)` and `half_turn` its 180° quaternion, both precomputed with the
+/// scalar code.
+#[inline(always)]
+pub fn rotation_arc_from(a: Vec3, half_turn: Quat, to: V3) -> Q {
+    let av = V3::splat(a);
+    let b = to.normalize_or(av);
+    let w = F::splat(1.0) + av.dot(b);
+    let c = av.cross(b);
+    let q = Q {
+        x: c.x,
+        y: c.y,
+        z: c.z,
+        w,
+    }
+    .normalize();
+    Q::select(w.lt(F::splat(1e-7)), Q::splat(half_turn), q)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::{normalize_or, rotation_arc};
+    use crate::rng::SplitMix64 as Rng;
+
+    fn rand_vec(r: &mut Rng, s: f32) -> Vec3 {
+        Vec3::new(r.range_f32(-s, s), r.range_f32(-s, s), r.range_f32(-s, s))
+    }
+    fn rand_quat(r: &mut Rng) -> Quat {
+        Quat::from_xyzw(
+            r.range_f32(-1.0, 1.0),
+            r.range_f32(-1.0, 1.0),
+            r.range_f32(-1.0, 1.0),
+            r.range_f32(-1.0, 1.0),
+        )
+        .normalize()
+    }
+    fn rand_transform(r: &mut Rng) -> Transform {
+        Transform::new(
+            rand_vec(r, 3.0),
+            rand_quat(r),
+            Vec3::new(
+                r.range_f32(0.5, 2.0),
+                r.range_f32(0.5, 2.0),
+                r.range_f32(0.5, 2.0),
+            ),
+        )
+    }
+    fn bits3(v: Vec3) -> [u32; 3] {
+        v.to_array().map(f32::to_bits)
+    }
+    fn bits4(q: Quat) -> [u32; 4] {
+        q.to_array().map(f32::to_bits)
+    }
+
+    /// Each lane operation against glam and `crate::math` on random inputs: the same
+    /// bits (what the crowd path's equality with the single-character path rests on).
+    #[test]
+    fn lane_operations_give_the_scalar_bits() {
+        let mut r = Rng::new(7);
+        for _ in 0..2000 {
+            let ta: [Transform; LANES] = std::array::from_fn(|_| rand_transform(&mut r));
+            let tb: [Transform; LANES] = std::array::from_fn(|_| rand_transform(&mut r));
+            let p: [Vec3; LANES] = std::array::from_fn(|_| rand_vec(&mut r, 2.0));
+            let mut la = Trs::splat(&Transform::IDENTITY);
+            let mut lb = la;
+            let mut lp = V3::splat(Vec3::ZERO);
+            for i in 0..LANES {
+                la.set(i, &ta[i]);
+                lb.set(i, &tb[i]);
+                lp.set(i, p[i]);
+            }
+            let m = la.mul(&lb);
+            let tp = la.transform_point(lp);
+            let itp = la.inverse_transform_point(lp);
+            let qv = la.r.mul_vec3(lp);
+            let qq = la.r.mul_quat(lb.r);
+            let n = lp.normalize_or(V3::splat(Vec3::Y));
+            let from = rand_vec(&mut r, 1.0);
+            let a = normalize_or(from, Vec3::Y);
+            let half = {
+                let o = a.any_orthonormal_vector();
+                Quat::from_xyzw(o.x, o.y, o.z, 0.0)
+            };
+            let arc = rotation_arc_from(a, half, lp);
+            for i in 0..LANES {
+                let want = ta[i] * tb[i];
+                assert_eq!(bits3(m.t.get(i)), bits3(want.translation));
+                assert_eq!(bits4(m.r.get(i)), bits4(want.rotation));
+                assert_eq!(bits3(m.s.get(i)), bits3(want.scale));
+                assert_eq!(bits3(tp.get(i)), bits3(ta[i].transform_point(p[i])));
+                assert_eq!(
+                    bits3(itp.get(i)),
+                    bits3(ta[i].inverse_transform_point(p[i]))
+                );
+                assert_eq!(bits3(qv.get(i)), bits3(ta[i].rotation * p[i]));
+                assert_eq!(bits4(qq.get(i)), bits4(ta[i].rotation * tb[i].rotation));
+                assert_eq!(bits3(n.get(i)), bits3(normalize_or(p[i], Vec3::Y)));
+                assert_eq!(bits4(arc.get(i)), bits4(rotation_arc(from, p[i])));
+            }
+        }
+    }
+
+    /// The special cases: a zero vector falls back, and antiparallel directions turn half
+    /// way round, as the scalar code does.
+    #[test]
+    fn lane_fallbacks_match_the_scalar_code() {
+        let a = Vec3::Y;
+        let o = a.any_orthonormal_vector();
+        let half = Quat::from_xyzw(o.x, o.y, o.z, 0.0);
+        let mut to = V3::splat(Vec3::new(0.3, 0.2, 0.1));
+        to.set(1, -Vec3::Y);
+        to.set(2, Vec3::ZERO);
+        to.set(3, Vec3::new(f32::NAN, 0.0, 0.0));
+        let q = rotation_arc_from(a, half, to);
+        for (i, v) in [
+            Vec3::new(0.3, 0.2, 0.1),
+            -Vec3::Y,
+            Vec3::ZERO,
+            Vec3::new(f32::NAN, 0.0, 0.0),
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            assert_eq!(bits4(q.get(i)), bits4(rotation_arc(a, v)), "lane {i}");
+        }
+        assert_eq!(q.get(1).w, 0.0);
+    }
+}

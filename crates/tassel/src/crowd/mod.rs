@@ -1,0 +1,15 @@
+//! Crowds: many characters of one kind, sharing one compiled rig, advanced together.
+//!
+//! A crowd keeps each character's solver state side by side in structure-of-arrays lane
+//! groups ([`lanes::LANES`] characters per group, one SIMD lane each) and steps the groups
+//! in parallel with rayon (threads of the current rayon pool, deterministic: a character's
+//! result never depends on the thread count or on its neighbours). It gives exactly the
+//! results of the single-character path ([`crate::CharacterSim`]), which stays the
+//! readable reference and against which the crowd is tested bit for bit.
+//!
+//! - [`VrmCrowd`]: VRM spring bones (`spec` and `three-vrm` modes).
+
+pub mod lanes;
+mod vrm;
+
+pub use vrm::{CrowdPose, VrmCrowd};

@@ -1,0 +1,311 @@
+//! The crowd path against the single-character path: the same bits, frame after frame,
+//! for every character, whatever the thread count.
+
+use glam::{Quat, Vec3};
+use std::sync::Arc;
+use tassel::crowd::{CrowdPose, VrmCrowd};
+use tassel::dynamics::vrm::{VrmMode, VrmOptions, VrmRig, VrmSpringBones};
+use tassel::dynamics::RigSettings;
+use tassel::{builtin, CharacterSim, Skeleton, Transform};
+
+/// Character `i`'s world transform and animated pose at frame `f`: its own phase of a
+/// sway, a bob and a turn, the root and one more joint swinging, a teleport of character 2
+/// at frame 100.
+fn motion(sk: &Skeleton, swing: usize, i: usize, f: usize, locals: &mut [Transform]) -> Transform {
+    let t = f as f32 / 60.0 + 0.37 * i as f32;
+    locals.copy_from_slice(sk.rest());
+    locals[0].rotation = sk.rest()[0].rotation * Quat::from_rotation_z(0.3 * (2.0 * t).sin());
+    locals[swing].rotation =
+        sk.rest()[swing].rotation * Quat::from_rotation_x(0.5 * (3.0 * t + 1.0).sin());
+    let jump = if i == 2 && f >= 100 { 10.0 } else { 0.0 };
+    Transform::from_translation_rotation(
+        Vec3::new((3.0 * t).sin() * 0.5 + jump, 0.1 * (5.0 * t).sin(), t),
+        Quat::from_rotation_y(0.4 * (2.0 * t).sin()),
+    )
+}
+
+/// Frame `f`'s time step: 60 Hz with a paused frame and a hitch.
+fn dt_at(f: usize) -> f32 {
+    match f {
+        200 => 0.0,
+        300 => 0.25,
+        _ => 1.0 / 60.0,
+    }
+}
+
+fn bits(t: &Transform) -> [u32; 10] {
+    let mut b = [0u32; 10];
+    for (k, v) in t
+        .translation
+        .to_array()
+        .into_iter()
+        .chain(t.rotation.to_array())
+        .chain(t.scale.to_array())
+        .enumerate()
+    {
+        b[k] = v.to_bits();
+    }
+    b
+}
+
+/// `n` characters through `frames` frames in a crowd and one `CharacterSim` each: every
+/// local and model transform of every character has the same bits after every frame.
+/// Returns how many link rotations were compared.
+fn assert_crowd_matches(
+    sk: &Skeleton,
+    bones: &VrmSpringBones,
+    mode: VrmMode,
+    n: usize,
+    frames: usize,
+) -> usize {
+    let options = VrmOptions {
+        mode,
+        teleport_distance: 2.0,
+        ..Default::default()
+    };
+    let rig = Arc::new(VrmRig::new(sk, bones, options).unwrap());
+    let swing = rig.links[0].parent.unwrap_or(0);
+    let mut crowd = VrmCrowd::new(Arc::new(sk.clone()), rig.clone()).unwrap();
+    let mut sims: Vec<CharacterSim> = (0..n)
+        .map(|_| {
+            crowd.add();
+            CharacterSim::with_vrm(sk.clone(), &RigSettings::default(), bones, options).unwrap()
+        })
+        .collect();
+    let mut inputs = vec![(Transform::IDENTITY, sk.rest().to_vec()); n];
+    let mut locals = sk.rest().to_vec();
+    let mut models = sk.rest().to_vec();
+    let mut compared = 0;
+    for f in 0..frames {
+        if f == 400 {
+            crowd.reset(3).unwrap();
+            sims[3].reset();
+        }
+        for (i, (t, l)) in inputs.iter_mut().enumerate() {
+            *t = motion(sk, swing, i, f, l);
+        }
+        let dt = dt_at(f);
+        crowd
+            .frame(dt, |i| CrowdPose {
+                transform: inputs[i].0,
+                locals: &inputs[i].1,
+            })
+            .unwrap();
+        for (i, sim) in sims.iter_mut().enumerate() {
+            let pose = sim.frame(&inputs[i].1, inputs[i].0, dt).unwrap();
+            locals.copy_from_slice(&inputs[i].1);
+            crowd.write_pose(i, &mut locals, &mut models).unwrap();
+            for j in 0..sk.len() {
+                assert_eq!(
+                    bits(&locals[j]),
+                    bits(&pose.locals[j]),
+                    "{mode:?}: frame {f}, character {i}, joint '{}': crowd {:?} vs single {:?}",
+                    sk.name(j),
+                    locals[j],
+                    pose.locals[j]
+                );
+                assert_eq!(bits(&models[j]), bits(&pose.models[j]), "frame {f}");
+            }
+            assert_eq!(
+                crowd.reset_count(i),
+                Some(sim.vrm_state().reset_count()),
+                "character {i}"
+            );
+            compared += rig.links.len();
+        }
+    }
+    // The motion really moved the springs, and the teleport and the reset were seen.
+    let swung = (0..rig.links.len())
+        .map(|k| {
+            crowd
+                .rotation(0, k)
+                .unwrap()
+                .angle_between(rig.links[k].rest_local.rotation)
+        })
+        .fold(0.0f32, f32::max);
+    assert!(swung > 0.05, "{mode:?}: springs barely moved ({swung} rad)");
+    assert_eq!(
+        crowd.reset_count(2),
+        Some(2),
+        "the teleport resets character 2"
+    );
+    assert_eq!(crowd.reset_count(3), Some(2), "the reset of character 3");
+    compared
+}
+
+#[test]
+fn vrm_crowd_gives_the_single_character_bits_on_the_bench_rig() {
+    let (sk, bones) = builtin::bench_vrm(16, 8, 8);
+    for mode in [VrmMode::Spec, VrmMode::ThreeVrm] {
+        // 11 characters: a full lane group and a partial one.
+        let compared = assert_crowd_matches(&sk, &bones, mode, 11, 600);
+        assert_eq!(compared, 11 * 600 * 16 * 7);
+    }
+}
+
+/// Springs with a centre, a plane and inside colliders, a tail given as an offset and a
+/// spring whose first joint is a skeleton root.
+#[test]
+fn vrm_crowd_gives_the_single_character_bits_with_centres_planes_and_inside_shapes() {
+    use tassel::dynamics::vrm::{
+        VrmCollider, VrmColliderGroup, VrmJoint, VrmShape, VrmSpring, VrmTail,
+    };
+    let (sk, mut bones) = builtin::bench_vrm(4, 6, 4);
+    bones.colliders.push(VrmCollider {
+        joint: 0,
+        shape: VrmShape::Plane {
+            offset: Vec3::new(0.0, -0.2, 0.0),
+            normal: Vec3::new(0.2, 1.0, 0.1),
+        },
+    });
+    bones.colliders.push(VrmCollider {
+        joint: 0,
+        shape: VrmShape::Sphere {
+            offset: Vec3::new(0.0, -0.1, 0.0),
+            radius: 0.33,
+            inside: true,
+        },
+    });
+    bones.colliders.push(VrmCollider {
+        joint: 0,
+        shape: VrmShape::Capsule {
+            offset: Vec3::new(0.0, 0.1, 0.0),
+            tail: Vec3::new(0.0, -0.4, 0.0),
+            radius: 0.3,
+            inside: true,
+        },
+    });
+    bones.collider_groups.push(VrmColliderGroup {
+        name: "new".into(),
+        colliders: vec![4, 5, 6],
+    });
+    for s in &mut bones.springs {
+        s.collider_groups.push(1);
+    }
+    bones.springs[1].center = Some(0);
+    bones.springs[2].center = Some(sk.find("c2_0").unwrap());
+    bones.springs.push(VrmSpring {
+        name: "root".into(),
+        joints: vec![VrmJoint {
+            joint: 0,
+            tail: VrmTail::Local(Vec3::new(0.0, 0.1, 0.05)),
+            stiffness: 0.5,
+            drag_force: 0.2,
+            ..Default::default()
+        }],
+        collider_groups: vec![],
+        center: None,
+    });
+    for mode in [VrmMode::Spec, VrmMode::ThreeVrm] {
+        assert_crowd_matches(&sk, &bones, mode, 9, 600);
+    }
+}
+
+/// The same crowd on one thread and on two, and on the baseline SSE2 path: the same bits.
+#[test]
+fn vrm_crowd_is_the_same_on_one_and_two_threads() {
+    let (sk, bones) = builtin::bench_vrm(8, 6, 8);
+    let rig = Arc::new(VrmRig::new(&sk, &bones, VrmOptions::default()).unwrap());
+    let sk = Arc::new(sk);
+    let run = |threads: usize, avx2: bool| -> Vec<u32> {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        let mut crowd = VrmCrowd::new(sk.clone(), rig.clone()).unwrap();
+        crowd.set_avx2(avx2);
+        for _ in 0..37 {
+            crowd.add();
+        }
+        let mut inputs = vec![(Transform::IDENTITY, sk.rest().to_vec()); 37];
+        pool.install(|| {
+            for f in 0..300 {
+                for (i, (t, l)) in inputs.iter_mut().enumerate() {
+                    *t = motion(&sk, 1, i, f, l);
+                }
+                crowd
+                    .frame(1.0 / 60.0, |i| CrowdPose {
+                        transform: inputs[i].0,
+                        locals: &inputs[i].1,
+                    })
+                    .unwrap();
+            }
+        });
+        (0..37)
+            .flat_map(|i| (0..rig.links.len()).map(move |k| (i, k)))
+            .flat_map(|(i, k)| crowd.rotation(i, k).unwrap().to_array())
+            .map(f32::to_bits)
+            .collect()
+    };
+    let one = run(1, true);
+    assert_eq!(one, run(2, true), "1 vs 2 threads");
+    assert_eq!(one, run(2, true), "run to run");
+    assert_eq!(one, run(2, false), "with and without AVX2");
+}
+
+/// Bad input names the character; its lane group keeps its state, the others step, and
+/// the next good frame goes on.
+#[test]
+fn vrm_crowd_rejects_bad_input_by_character() {
+    let (sk, bones) = builtin::bench_vrm(4, 5, 2);
+    let rig = Arc::new(VrmRig::new(&sk, &bones, VrmOptions::default()).unwrap());
+    let sk = Arc::new(sk);
+    let mut crowd = VrmCrowd::new(sk.clone(), rig.clone()).unwrap();
+    for _ in 0..20 {
+        crowd.add();
+    }
+    let rest = sk.rest().to_vec();
+    let mut bad = rest.clone();
+    bad[3].translation.x = f32::NAN;
+    let at =
+        |f: usize, i: usize| Transform::from_translation(Vec3::X * (f as f32 * 0.05 + i as f32));
+    crowd
+        .frame(1.0 / 60.0, |i| CrowdPose {
+            transform: at(0, i),
+            locals: &rest,
+        })
+        .unwrap();
+    let before: Vec<Quat> = (0..20).map(|i| crowd.rotation(i, 2).unwrap()).collect();
+    let err = crowd
+        .frame(1.0 / 60.0, |i| CrowdPose {
+            transform: at(1, i),
+            locals: if i == 17 { &bad } else { &rest },
+        })
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("crowd character 17") && err.contains(sk.name(3)),
+        "{err}"
+    );
+    for i in 0..20 {
+        let kept = crowd.rotation(i, 2).unwrap() == before[i];
+        assert_eq!(kept, i >= 16, "character {i}: only 17's lane group is held");
+    }
+    let short = &rest[..3];
+    let err = crowd
+        .frame(1.0 / 60.0, |i| CrowdPose {
+            transform: at(2, i),
+            locals: if i == 4 { short } else { &rest },
+        })
+        .unwrap_err();
+    assert!(err.to_string().contains("expected"), "{err}");
+    assert!(crowd
+        .frame(f32::NAN, |_| CrowdPose {
+            transform: Transform::IDENTITY,
+            locals: &rest,
+        })
+        .is_err());
+    crowd
+        .frame(1.0 / 60.0, |i| CrowdPose {
+            transform: at(3, i),
+            locals: &rest,
+        })
+        .unwrap();
+    assert!(crowd.rotation(20, 0).is_none() && crowd.reset(20).is_err());
+    let fixed = VrmOptions {
+        mode: VrmMode::Fixed,
+        ..Default::default()
+    };
+    let fixed_rig = Arc::new(VrmRig::new(&sk, &bones, fixed).unwrap());
+    assert!(VrmCrowd::new(sk, fixed_rig).is_err());
+}
