@@ -1,0 +1,167 @@
+//! The crowd path on the real VRM files in ../shared/testdata/vrm/: every character of a
+//! `VrmCrowd` gives the bits of its own `CharacterSim`, frame after frame, in the `spec`
+//! and `three-vrm` modes, with node constraints too.
+
+mod common;
+
+use common::testdata;
+use glam::{Quat, Vec3};
+use std::path::PathBuf;
+use std::sync::Arc;
+use tassel::crowd::{CrowdPose, VrmCrowd};
+use tassel::dynamics::vrm::{VrmMode, VrmOptions, VrmRig, VrmSpringBones};
+use tassel::dynamics::RigSettings;
+use tassel::{CharacterSim, Skeleton, Transform};
+use tassel_gltf::Model;
+
+fn vrm_files() -> Vec<PathBuf> {
+    let Some(dir) = testdata("vrm") else {
+        return vec![];
+    };
+    let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| matches!(p.extension().and_then(|e| e.to_str()), Some("vrm" | "gltf")))
+        .collect();
+    files.sort();
+    assert!(
+        files.len() >= 8,
+        "expected the 8 VRM fixtures, found {files:?}"
+    );
+    files
+}
+
+/// Character `i` at frame `f`: its own phase of a sway that rolls it over (so that gravity
+/// throws the springs against the colliders), joint 0 and the first spring joint's parent
+/// swinging in the animated pose.
+fn input(sk: &Skeleton, swing: usize, i: usize, f: usize, locals: &mut [Transform]) -> Transform {
+    let t = f as f32 / 60.0 + 0.29 * i as f32;
+    let w = std::f32::consts::TAU * t;
+    locals.copy_from_slice(sk.rest());
+    locals[swing].rotation =
+        sk.rest()[swing].rotation * Quat::from_rotation_x(0.4 * (2.0 * w).sin());
+    let roll = std::f32::consts::FRAC_PI_2 * (1.0 - (0.5 * w).cos());
+    Transform::from_translation_rotation(
+        Vec3::new(
+            0.15 * w.sin(),
+            0.05 * (1.7 * w).sin(),
+            0.1 * (0.6 * w).cos(),
+        ),
+        Quat::from_rotation_y(0.6 * (0.8 * w).sin()) * Quat::from_rotation_z(roll),
+    )
+}
+
+fn bits(t: &Transform) -> Vec<u32> {
+    t.translation
+        .to_array()
+        .into_iter()
+        .chain(t.rotation.to_array())
+        .chain(t.scale.to_array())
+        .map(f32::to_bits)
+        .collect()
+}
+
+/// Five characters, 600 frames (a hitch at frame 300): every local and model transform of
+/// every character the same bits in the crowd and in its own `CharacterSim`. Returns the
+/// largest angle any spring joint turned away from its rest rotation (the test's own
+/// check that something moved).
+fn compare(name: &str, sk: &Skeleton, bones: &VrmSpringBones, mode: VrmMode) -> f32 {
+    let options = VrmOptions {
+        mode,
+        ..Default::default()
+    };
+    let rig = Arc::new(VrmRig::new(sk, bones, options).unwrap());
+    let swing = rig.links.first().and_then(|l| l.parent).unwrap_or(0);
+    let mut crowd = VrmCrowd::new(Arc::new(sk.clone()), rig.clone()).unwrap();
+    let n = 5;
+    let mut sims: Vec<CharacterSim> = (0..n)
+        .map(|_| {
+            crowd.add();
+            CharacterSim::with_vrm(sk.clone(), &RigSettings::default(), bones, options).unwrap()
+        })
+        .collect();
+    let mut inputs = vec![(Transform::IDENTITY, sk.rest().to_vec()); n];
+    let (mut locals, mut models) = (sk.rest().to_vec(), sk.rest().to_vec());
+    let mut turned = 0.0f32;
+    for f in 0..600 {
+        for (i, (t, l)) in inputs.iter_mut().enumerate() {
+            *t = input(sk, swing, i, f, l);
+        }
+        let dt = if f == 300 { 0.2 } else { 1.0 / 60.0 };
+        crowd
+            .frame(dt, |i| CrowdPose {
+                transform: inputs[i].0,
+                locals: &inputs[i].1,
+            })
+            .unwrap();
+        for (i, sim) in sims.iter_mut().enumerate() {
+            let pose = sim.frame(&inputs[i].1, inputs[i].0, dt).unwrap();
+            locals.copy_from_slice(&inputs[i].1);
+            crowd.write_pose(i, &mut locals, &mut models).unwrap();
+            for j in 0..sk.len() {
+                assert_eq!(
+                    (bits(&locals[j]), bits(&models[j])),
+                    (bits(&pose.locals[j]), bits(&pose.models[j])),
+                    "{name} {mode:?}: frame {f}, character {i}, joint '{}'",
+                    sk.name(j)
+                );
+            }
+        }
+        for (k, l) in rig.links.iter().enumerate() {
+            turned = turned.max(
+                crowd
+                    .rotation(0, k)
+                    .unwrap()
+                    .angle_between(l.rest_local.rotation),
+            );
+        }
+    }
+    turned
+}
+
+#[test]
+fn vrm_crowd_gives_each_files_single_character_bits() {
+    for path in vrm_files() {
+        let model = tassel_gltf::load(&path).unwrap();
+        let bones = model.vrm.clone().unwrap().springs;
+        let name = path.file_name().unwrap().to_string_lossy().to_string();
+        for mode in [VrmMode::Spec, VrmMode::ThreeVrm] {
+            let turned = compare(&name, &model.skeleton, &bones, mode);
+            assert!(
+                turned > 0.05,
+                "{name} {mode:?}: the springs never moved ({turned} rad)"
+            );
+        }
+    }
+}
+
+/// Node constraints (roll, aim and rotation, applied before the springs) in a crowd.
+#[test]
+fn vrm_crowd_applies_node_constraints_as_the_single_path_does() {
+    let Some(path) = testdata("vrm/sphere-collider.gltf") else {
+        return;
+    };
+    let bytes = std::fs::read(&path).unwrap();
+    let mut json: serde_json::Value = serde_json::from_slice(&bytes).unwrap();
+    json["extensionsUsed"] = serde_json::json!(["VRMC_springBone", "VRMC_node_constraint"]);
+    for (node, c) in [
+        (
+            5,
+            serde_json::json!({"roll": {"source": 1, "rollAxis": "Y", "weight": 0.7}}),
+        ),
+        (
+            3,
+            serde_json::json!({"aim": {"source": 1, "aimAxis": "NegativeY"}}),
+        ),
+    ] {
+        json["nodes"][node]["extensions"] =
+            serde_json::json!({ "VRMC_node_constraint": {"specVersion": "1.0", "constraint": c} });
+    }
+    let bytes = serde_json::to_vec(&json).unwrap();
+    let model: Model = tassel_gltf::load_slice(&bytes, path.parent(), "edited.gltf").unwrap();
+    let bones = model.vrm.clone().unwrap().springs;
+    assert_eq!(bones.node_constraints.len(), 2);
+    for mode in [VrmMode::Spec, VrmMode::ThreeVrm] {
+        compare("constrained sphere-collider", &model.skeleton, &bones, mode);
+    }
+}
