@@ -134,12 +134,19 @@ impl Transform {
     /// Finite, a unit rotation (length within 10 %: a quaternion far from unit length
     /// scales every vector it turns), and every translation coordinate and scale factor
     /// within [`crate::limits::MAX_COORDINATE`]: the range Tassel accepts as input.
+    #[inline]
     pub fn within_limits(&self) -> bool {
+        // Every comparison with NaN is false and infinity is beyond the limit, so these
+        // also reject what is not finite; `&` rather than `&&`: no branch per component.
         let max = crate::limits::MAX_COORDINATE;
-        self.is_finite()
-            && (self.rotation.length_squared() - 1.0).abs() <= 0.21
-            && self.translation.abs().max_element() <= max
-            && self.scale.abs().max_element() <= max
+        let (t, s) = (self.translation.abs(), self.scale.abs());
+        ((self.rotation.length_squared() - 1.0).abs() <= 0.21)
+            & (t.x <= max)
+            & (t.y <= max)
+            & (t.z <= max)
+            & (s.x <= max)
+            & (s.y <= max)
+            & (s.z <= max)
     }
 }
 
