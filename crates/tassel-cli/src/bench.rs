@@ -24,7 +24,7 @@ pub struct Args {
     #[arg(long, conflicts_with = "vrm")]
     cloth: bool,
     /// A crowd of this many characters, each on its own phase of the motion, advanced
-    /// together every frame: VRM springs in spec or three-vrm mode through the crowd path
+    /// together every frame: VRM springs (any mode) through the crowd path
     /// (`tassel::crowd`, lane groups of 8), other solvers one `CharacterSim` each.
     #[arg(long)]
     crowd: Option<usize>,
@@ -160,7 +160,7 @@ fn crowd(a: &Args, n: usize) -> Result<(), String> {
     }
     let threads = a.threads.min(n);
     let frames = a.frames.max(1);
-    let crowd_path = matches!(a.vrm, Some(VrmBenchMode::Spec | VrmBenchMode::ThreeVrm));
+    let crowd_path = a.vrm.is_some();
     let reference = if !crowd_path || a.compare {
         Some(sims_crowd(a, n, threads, frames)?)
     } else {
@@ -204,6 +204,7 @@ fn vrm_crowd(
     let (sk, bones) = builtin::bench_vrm(16, 8, 8);
     let mode = match a.vrm {
         Some(VrmBenchMode::ThreeVrm) => VrmMode::ThreeVrm,
+        Some(VrmBenchMode::Fixed) => VrmMode::Fixed,
         _ => VrmMode::Spec,
     };
     let options = VrmOptions {

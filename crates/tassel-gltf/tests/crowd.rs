@@ -1,6 +1,6 @@
 //! The crowd path on the real VRM files in ../shared/testdata/vrm/: every character of a
-//! `VrmCrowd` gives the bits of its own `CharacterSim`, frame after frame, in the `spec`
-//! and `three-vrm` modes, with node constraints too.
+//! `VrmCrowd` gives the bits of its own `CharacterSim`, frame after frame, in the `spec`,
+//! `three-vrm` and `fixed` (60 and 90 Hz steps) modes, with node constraints too.
 
 mod common;
 
@@ -65,9 +65,15 @@ fn bits(t: &Transform) -> Vec<u32> {
 /// every character the same bits in the crowd and in its own `CharacterSim`. Returns the
 /// largest angle any spring joint turned away from its rest rotation (the test's own
 /// check that something moved).
-fn compare(name: &str, sk: &Skeleton, bones: &VrmSpringBones, mode: VrmMode) -> f32 {
+fn compare(
+    name: &str,
+    sk: &Skeleton,
+    bones: &VrmSpringBones,
+    (mode, step_rate): (VrmMode, f32),
+) -> f32 {
     let options = VrmOptions {
         mode,
+        step_rate,
         ..Default::default()
     };
     let rig = Arc::new(VrmRig::new(sk, bones, options).unwrap());
@@ -119,13 +125,21 @@ fn compare(name: &str, sk: &Skeleton, bones: &VrmSpringBones, mode: VrmMode) -> 
     turned
 }
 
+/// Every mode; fixed at the frame rate and at 90 Hz.
+const MODES: [(VrmMode, f32); 4] = [
+    (VrmMode::Spec, 60.0),
+    (VrmMode::ThreeVrm, 60.0),
+    (VrmMode::Fixed, 60.0),
+    (VrmMode::Fixed, 90.0),
+];
+
 #[test]
 fn vrm_crowd_gives_each_files_single_character_bits() {
     for path in vrm_files() {
         let model = tassel_gltf::load(&path).unwrap();
         let bones = model.vrm.clone().unwrap().springs;
         let name = path.file_name().unwrap().to_string_lossy().to_string();
-        for mode in [VrmMode::Spec, VrmMode::ThreeVrm] {
+        for mode in MODES {
             let turned = compare(&name, &model.skeleton, &bones, mode);
             assert!(
                 turned > 0.05,
@@ -161,7 +175,7 @@ fn vrm_crowd_applies_node_constraints_as_the_single_path_does() {
     let model: Model = tassel_gltf::load_slice(&bytes, path.parent(), "edited.gltf").unwrap();
     let bones = model.vrm.clone().unwrap().springs;
     assert_eq!(bones.node_constraints.len(), 2);
-    for mode in [VrmMode::Spec, VrmMode::ThreeVrm] {
+    for mode in MODES {
         compare("constrained sphere-collider", &model.skeleton, &bones, mode);
     }
 }

@@ -575,6 +575,210 @@ pub fn rotation_arc_from(a: Vec3, half_turn: Quat, to: V3) -> Q {
     Q::select(w.lt(F::splat(1e-7)), Q::splat(half_turn), q)
 }
 
+impl F {
+    /// `|self|` per lane.
+    #[inline(always)]
+    pub fn abs(self) -> F {
+        let mut r = [0.0f32; LANES];
+        for i in 0..LANES {
+            r[i] = self.0[i].abs();
+        }
+        F(r)
+    }
+
+    /// `f32::clamp(self, 0, 1)` per lane (NaN stays NaN).
+    #[inline(always)]
+    pub fn clamp01(self) -> F {
+        let mut r = [0.0f32; LANES];
+        for i in 0..LANES {
+            r[i] = self.0[i].clamp(0.0, 1.0);
+        }
+        F(r)
+    }
+
+    /// `f32::max` per lane.
+    #[inline(always)]
+    pub fn max(self, o: F) -> F {
+        let mut r = [0.0f32; LANES];
+        for i in 0..LANES {
+            r[i] = self.0[i].max(o.0[i]);
+        }
+        F(r)
+    }
+
+    /// Lane `i`.
+    #[inline(always)]
+    pub fn get(self, i: usize) -> f32 {
+        self.0[i]
+    }
+}
+
+/// glam's scalar `acos_approx` (DirectXMath's 7th-degree minimax), per lane.
+#[inline(always)]
+fn acos_approx(v: F) -> F {
+    let nonnegative = F::splat(0.0).le(v);
+    let x = v.abs();
+    let omx = F::splat(1.0) - x;
+    let omx = F::select(omx.lt(F::splat(0.0)), F::splat(0.0), omx);
+    let root = omx.sqrt();
+    let c = F::splat;
+    let r = c(-0.001_262_491_1) * x + c(0.006_670_09);
+    let r = r * x - c(0.017_088_126);
+    let r = r * x + c(0.030_891_88);
+    let r = r * x - c(0.050_174_303);
+    let r = r * x + c(0.088_978_99);
+    let r = r * x - c(0.214_598_8);
+    let result = r * x + c(1.570_796_3);
+    let result = result * root;
+    F::select(nonnegative, result, c(std::f32::consts::PI) - result)
+}
+
+/// glam's SSE2 `m128_sin` (DirectXMath's 11th-degree minimax after reduction to
+/// [-π, π] and reflection into [-π/2, π/2]), per lane.
+#[inline(always)]
+fn sin_approx(v: F) -> F {
+    let c = F::splat;
+    // m128_mod_angles: v − 2π·round(v / 2π), rounding by the 2^23 trick.
+    let q = v * c(0.159_154_94);
+    let mut rounded = [0.0f32; LANES];
+    for i in 0..LANES {
+        let x = q.0[i];
+        let magic = f32::from_bits(8_388_608f32.to_bits() | (x.to_bits() & 0x8000_0000));
+        let r1 = (x + magic) - magic;
+        rounded[i] = if x.abs() <= 8_388_608.0 { r1 } else { x };
+    }
+    let x = v - c(std::f32::consts::TAU) * F(rounded);
+    let mut y = [0.0f32; LANES];
+    for i in 0..LANES {
+        let xi = x.0[i];
+        let sign = xi.to_bits() & 0x8000_0000;
+        let pi = f32::from_bits(std::f32::consts::PI.to_bits() | sign);
+        y[i] = if f32::from_bits(xi.to_bits() & 0x7fff_ffff) <= std::f32::consts::FRAC_PI_2 {
+            xi
+        } else {
+            pi - xi
+        };
+    }
+    let x = F(y);
+    let x2 = x * x;
+    let r = c(-2.388_985_9e-8) * x2 + c(2.752_556_2e-6);
+    let r = r * x2 + c(-0.000_198_408_74);
+    let r = r * x2 + c(0.008_333_331);
+    let r = r * x2 + c(-0.166_666_67);
+    let r = r * x2 + c(1.0);
+    r * x
+}
+
+impl Q {
+    /// Scaled per lane.
+    #[inline(always)]
+    fn scale(self, s: F) -> Q {
+        Q {
+            x: self.x * s,
+            y: self.y * s,
+            z: self.z * s,
+            w: self.w * s,
+        }
+    }
+
+    #[inline(always)]
+    fn add(self, o: Q) -> Q {
+        Q {
+            x: self.x + o.x,
+            y: self.y + o.y,
+            z: self.z + o.z,
+            w: self.w + o.w,
+        }
+    }
+
+    #[inline(always)]
+    fn neg(self) -> Q {
+        Q {
+            x: -self.x,
+            y: -self.y,
+            z: -self.z,
+            w: -self.w,
+        }
+    }
+
+    /// glam's SSE2 `Quat::slerp`, per lane.
+    #[inline(always)]
+    pub fn slerp(self, end: Q, s: F) -> Q {
+        let dot = self.dot(end);
+        let flip = dot.lt(F::splat(0.0));
+        let end = Q::select(flip, end.neg(), end);
+        let dot = F::select(flip, -dot, dot);
+        let one = F::splat(1.0);
+        let near = dot.gt(F::splat(1.0 - f32::EPSILON));
+        let lerped = self.scale(one - s).add(end.scale(s)).normalize();
+        let theta = acos_approx(dot);
+        let scale1 = sin_approx(theta * (one - s));
+        let scale2 = sin_approx(theta * s);
+        let theta_sin = sin_approx(theta * one);
+        let a = self.scale(scale1).add(end.scale(scale2));
+        let slerped = Q {
+            x: a.x / theta_sin,
+            y: a.y / theta_sin,
+            z: a.z / theta_sin,
+            w: a.w / theta_sin,
+        };
+        Q::select(near, lerped, slerped)
+    }
+
+    /// [`crate::math::slerp_shortest`] per lane.
+    #[inline(always)]
+    pub fn slerp_shortest(self, b: Q, t: F) -> Q {
+        let b = Q::select(self.dot(b).lt(F::splat(0.0)), b.neg(), b);
+        self.slerp(b, t).normalize()
+    }
+}
+
+impl V3 {
+    /// glam's `Vec3::lerp`: `self·(1 − s) + rhs·s`.
+    #[inline(always)]
+    pub fn lerp(self, rhs: V3, s: F) -> V3 {
+        self * (F::splat(1.0) - s) + rhs * s
+    }
+
+    /// glam's `Vec3::any_orthonormal_vector` per lane.
+    #[inline(always)]
+    pub fn any_orthonormal(self) -> V3 {
+        let mut sign = [0.0f32; LANES];
+        for i in 0..LANES {
+            sign[i] = self.z.0[i].signum();
+        }
+        let sign = F(sign);
+        let a = F::splat(-1.0) / (sign + self.z);
+        let b = self.x * self.y * a;
+        V3 {
+            x: b,
+            y: sign + self.y * self.y * a,
+            z: -self.y,
+        }
+    }
+}
+
+impl Trs {
+    /// [`Transform::lerp`] per lane.
+    #[inline(always)]
+    pub fn lerp(&self, other: &Trs, t: F) -> Trs {
+        Trs {
+            t: self.t.lerp(other.t, t),
+            r: self.r.slerp_shortest(other.r, t),
+            s: self.s.lerp(other.s, t),
+        }
+    }
+}
+
+/// [`crate::math::closest_point_on_segment`] per lane.
+#[inline(always)]
+pub fn closest_point_on_segment(p: V3, a: V3, b: V3) -> V3 {
+    let ab = b - a;
+    let len2 = ab.dot(ab);
+    let t = ((p - a).dot(ab) / len2).clamp01();
+    V3::select(len2.le(F::splat(1e-20)), a, a + ab * t)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -655,6 +859,75 @@ mod tests {
                 assert_eq!(bits4(qq.get(i)), bits4(ta[i].rotation * tb[i].rotation));
                 assert_eq!(bits3(n.get(i)), bits3(normalize_or(p[i], Vec3::Y)));
                 assert_eq!(bits4(arc.get(i)), bits4(rotation_arc(from, p[i])));
+            }
+        }
+    }
+
+    /// Interpolation as the fixed-step path uses it: glam's slerp (its own acos and sine
+    /// approximations), the shortest-way slerp, transform lerp, and the other helpers.
+    #[test]
+    fn lane_interpolation_gives_the_scalar_bits() {
+        use crate::math::{closest_point_on_segment as cps, slerp_shortest};
+        let mut r = Rng::new(11);
+        for round in 0..3000 {
+            let ta: [Transform; LANES] = std::array::from_fn(|_| rand_transform(&mut r));
+            let mut tb: [Transform; LANES] = std::array::from_fn(|_| rand_transform(&mut r));
+            // Nearly equal and opposite rotations too: the lerp branch and the flip.
+            if round % 3 == 0 {
+                for (b, a) in tb.iter_mut().zip(&ta) {
+                    b.rotation = (a.rotation
+                        * Quat::from_rotation_x(1e-4 * r.range_f32(-1.0, 1.0)))
+                    .normalize();
+                }
+            }
+            if round % 3 == 1 {
+                tb[0].rotation = -ta[0].rotation;
+            }
+            let w: [f32; LANES] = std::array::from_fn(|i| match i {
+                0 => 0.0,
+                1 => 1.0,
+                _ => r.range_f32(0.0, 1.0),
+            });
+            let (mut la, mut lb) = (
+                Trs::splat(&Transform::IDENTITY),
+                Trs::splat(&Transform::IDENTITY),
+            );
+            for i in 0..LANES {
+                la.set(i, &ta[i]);
+                lb.set(i, &tb[i]);
+            }
+            let lw = F(w);
+            let l = la.lerp(&lb, lw);
+            let sl = la.r.slerp(lb.r, lw);
+            let ortho = la.t.normalize_or(V3::splat(Vec3::Y)).any_orthonormal();
+            let seg = closest_point_on_segment(lb.t, la.t, la.t + lb.s);
+            for i in 0..LANES {
+                let want = ta[i].lerp(&tb[i], w[i]);
+                assert_eq!(bits3(l.t.get(i)), bits3(want.translation));
+                assert_eq!(
+                    bits4(l.r.get(i)),
+                    bits4(want.rotation),
+                    "round {round} lane {i}"
+                );
+                assert_eq!(bits3(l.s.get(i)), bits3(want.scale));
+                assert_eq!(
+                    bits4(sl.get(i)),
+                    bits4(ta[i].rotation.slerp(tb[i].rotation, w[i]))
+                );
+                assert_eq!(
+                    bits4(la.r.slerp_shortest(lb.r, lw).get(i)),
+                    bits4(slerp_shortest(ta[i].rotation, tb[i].rotation, w[i]))
+                );
+                let n = normalize_or(ta[i].translation, Vec3::Y);
+                assert_eq!(bits3(ortho.get(i)), bits3(n.any_orthonormal_vector()));
+                assert_eq!(
+                    bits3(seg.get(i)),
+                    bits3(cps(
+                        tb[i].translation,
+                        ta[i].translation,
+                        ta[i].translation + tb[i].scale
+                    ))
+                );
             }
         }
     }

@@ -7,7 +7,7 @@
 //! results of the single-character path ([`crate::CharacterSim`]), which stays the
 //! readable reference and against which the crowd is tested bit for bit.
 //!
-//! - [`VrmCrowd`]: VRM spring bones (`spec` and `three-vrm` modes).
+//! - [`VrmCrowd`]: VRM spring bones (`fixed`, `spec` and `three-vrm` modes).
 
 pub mod lanes;
 mod vrm;

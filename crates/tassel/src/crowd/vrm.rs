@@ -1,5 +1,5 @@
-//! [`VrmCrowd`]: the VRM spring-bone update of [`crate::dynamics::vrm::VrmJob`] for many
-//! characters of one rig, [`LANES`] characters per lane group.
+//! [`VrmCrowd`]: the VRM spring-bone frame of [`crate::dynamics::vrm::VrmJob`] (every
+//! mode) for many characters of one rig, [`LANES`] characters per lane group.
 //!
 //! The frame is the scalar job's, reorganised for lanes: the rig's links are sorted by
 //! joint (ancestors first), so its lazy model refresh is one pass over the joints in
@@ -7,7 +7,8 @@
 //! tails) is the same for all lanes. Branches that depend on a character's state (a
 //! contact, a fallback, a reset) are computed for every lane and selected per lane.
 
-use super::lanes::{rotation_arc_from, Trs, F, LANES, M, Q, V3};
+use super::lanes::{closest_point_on_segment, rotation_arc_from, Trs, F, LANES, M, Q, V3};
+use crate::dynamics::path::CharacterPath;
 use crate::dynamics::vrm::{VrmMode, VrmRig, VrmShape};
 use crate::error::{Error, Result};
 use crate::math::{normalize_or, Transform};
@@ -157,6 +158,15 @@ struct Pack {
     length: Vec<F>,
     stale_tail: Vec<V3>,
     rotation: Vec<Q>,
+    /// Fixed mode: the rotations one step before `rotation`.
+    rotation_before: Vec<Q>,
+    /// The rotations the last frame wrote (fixed mode: between the last two steps).
+    out_rotation: Vec<Q>,
+    /// Fixed mode: last frame's animated locals (per plan slot) and each character's
+    /// recent transforms, and the time not yet stepped.
+    prev_locals: Vec<Trs>,
+    paths: Vec<CharacterPath>,
+    accumulator: [f32; LANES],
     prev_component: Trs,
     needs_reset: [bool; LANES],
     resets: [u64; LANES],
@@ -165,15 +175,21 @@ struct Pack {
 }
 
 impl Pack {
-    fn new(links: usize) -> Pack {
+    fn new(links: usize, slots: usize) -> Pack {
         let zero = V3::splat(Vec3::ZERO);
+        let id = Q::splat(Quat::IDENTITY);
         Pack {
             count: 0,
             current_tail: vec![zero; links],
             prev_tail: vec![zero; links],
             length: vec![F::splat(0.0); links],
             stale_tail: vec![zero; links],
-            rotation: vec![Q::splat(Quat::IDENTITY); links],
+            rotation: vec![id; links],
+            rotation_before: vec![id; links],
+            out_rotation: vec![id; links],
+            prev_locals: vec![Trs::splat(&Transform::IDENTITY); slots],
+            paths: vec![CharacterPath::default(); LANES],
+            accumulator: [0.0; LANES],
             prev_component: Trs::splat(&Transform::IDENTITY),
             needs_reset: [true; LANES],
             resets: [0; LANES],
@@ -199,6 +215,8 @@ struct Scratch {
     locals: Vec<Trs>,
     models: Vec<Trs>,
     reset_models: Vec<Trs>,
+    step_locals: Vec<Trs>,
+    step_models: Vec<Trs>,
     placed: Vec<Placed>,
     full_locals: Vec<Transform>,
     full_models: Vec<Transform>,
@@ -213,6 +231,8 @@ impl Scratch {
             locals: vec![id; plan.joints.len()],
             models: vec![id; plan.joints.len()],
             reset_models: vec![id; plan.joints.len()],
+            step_locals: vec![id; plan.joints.len()],
+            step_models: vec![id; plan.joints.len()],
             placed: vec![
                 Placed {
                     a: zero,
@@ -239,8 +259,9 @@ impl Scratch {
 /// [`VrmCrowd::write_pose`] writes into a pose.
 ///
 /// Results are those of [`crate::CharacterSim::with_vrm`] on the same input, bit for
-/// bit, and do not depend on the number of threads. Modes: `spec` and `three-vrm`
-/// (`fixed` is refused by [`VrmCrowd::new`] for now).
+/// bit, and do not depend on the number of threads. Every mode: `fixed` (steps at the rig's
+/// rate with the pose and the character transform interpolated, output between the last
+/// two steps), `spec` and `three-vrm`.
 ///
 /// ```
 /// use std::sync::Arc;
@@ -292,13 +313,6 @@ impl VrmCrowd {
                 got: rig.joint_count(),
             });
         }
-        if rig.options.mode == VrmMode::Fixed {
-            return Err(Error::InvalidParameter(
-                "crowd: VRM fixed mode is not supported by VrmCrowd yet; use spec or three-vrm, \
-                 or CharacterSim per character"
-                    .into(),
-            ));
-        }
         let plan = Plan::new(&skeleton, &rig)?;
         let links = rig.links.len();
         Ok(Self {
@@ -317,7 +331,8 @@ impl VrmCrowd {
     /// Adds a character; returns its index. It starts from its pose on its first frame.
     pub fn add(&mut self) -> usize {
         if self.len % LANES == 0 {
-            self.packs.push(Pack::new(self.rig.links.len()));
+            self.packs
+                .push(Pack::new(self.rig.links.len(), self.plan.joints.len()));
         }
         let i = self.len;
         let pack = &mut self.packs[i / LANES];
@@ -387,7 +402,7 @@ impl VrmCrowd {
         if i >= self.len || link >= self.rig.links.len() {
             return None;
         }
-        Some(self.packs[i / LANES].rotation[link].get(i % LANES))
+        Some(self.packs[i / LANES].out_rotation[link].get(i % LANES))
     }
 
     /// Character `i`'s current tail of link `link`, world space (or its spring's centre
@@ -423,7 +438,7 @@ impl VrmCrowd {
         }
         let pack = &self.packs[i / LANES];
         for (k, l) in self.rig.links.iter().enumerate() {
-            locals[l.joint].rotation = pack.rotation[k].get(i % LANES);
+            locals[l.joint].rotation = pack.out_rotation[k].get(i % LANES);
         }
         LocalToModelJob {
             skeleton: sk,
@@ -453,9 +468,14 @@ impl VrmCrowd {
         if self.packs.is_empty() {
             return Ok(());
         }
+        // The update's time step: the frame's, or fixed mode's step.
+        let h = match self.rig.options.mode {
+            VrmMode::Fixed => 1.0 / self.rig.options.step_rate,
+            _ => dt,
+        };
         for (k, l) in self.rig.links.iter().enumerate() {
-            self.stiffness_dt[k] = l.stiffness * dt;
-            self.external[k] = l.gravity * dt;
+            self.stiffness_dt[k] = l.stiffness * h;
+            self.external[k] = l.gravity * h;
         }
         let threads = rayon::current_num_threads().max(1);
         let chunk = self.packs.len().div_ceil(threads);
@@ -605,43 +625,33 @@ fn under(parent: Option<&Trs>, local: &Trs) -> Trs {
     }
 }
 
-/// The specification's collision query per lane
-/// ([`crate::dynamics::vrm::PlacedVrmCollider::collision`]): `None` when no lane can be in
-/// contact, else the push direction, the signed distance (negative in contact) and the
-/// lanes in contact.
+/// The specification's signed distance per lane
+/// ([`crate::dynamics::vrm::PlacedVrmCollider::collision`]) with the vector it is measured
+/// along, or `None` when no lane can be in contact.
 ///
-/// The early `None` compares squared distances against a bound rounded outward, so it
-/// only ever skips what the exact test would find out of contact: the results keep the
-/// scalar bits. The direction (three divisions and a square root) is computed only when a
-/// lane is in contact, since no other lane reads it.
+/// The early `None` compares against a bounding sphere rounded outward, so it only ever
+/// skips what the exact test would find out of contact: the results keep the scalar bits.
 #[inline(always)]
-fn contact(shape: &VrmShape, placed: &Placed, p: V3, r: f32) -> Option<(V3, F, M)> {
+fn distance(shape: &VrmShape, placed: &Placed, p: V3, r: f32) -> Option<(F, V3)> {
     let zero = F::splat(0.0);
     let (radius, inside) = match *shape {
         VrmShape::Sphere { radius, inside, .. } | VrmShape::Capsule { radius, inside, .. } => {
             (radius, inside)
         }
         VrmShape::Plane { .. } => {
-            let dist = (p - placed.a).dot(placed.b) - F::splat(r);
-            let hit = dist.lt(zero);
-            return if hit.any() {
-                Some((placed.b, dist, hit))
-            } else {
-                None
-            };
+            return Some(((p - placed.a).dot(placed.b) - F::splat(r), placed.b));
         }
     };
     if !inside {
         // Certainly out of reach: farther from the bounding sphere's centre than its
-        // radius plus the contact distance, with 1e-4 to spare for the rounding of
-        // these few operations (so that no lane the exact test would push is skipped).
+        // radius plus the contact distance, with 1e-4 to spare for the rounding of these
+        // few operations (so that no lane the exact test would push is skipped).
         let reach = (placed.half + F::splat(radius + r)) * F::splat(1.0001) + F::splat(1e-6);
         let far = (p - placed.mid).dot(p - placed.mid).gt(reach * reach);
         if far == M::ALL {
             return None;
         }
     }
-    // The exact query, as the scalar code computes it.
     let delta = match *shape {
         VrmShape::Capsule { .. } => {
             let (a, b) = (placed.a, placed.b);
@@ -656,19 +666,104 @@ fn contact(shape: &VrmShape, placed: &Placed, p: V3, r: f32) -> Option<(V3, F, M
         _ => p - placed.a,
     };
     let len = delta.length();
-    let dist = if inside {
-        F::splat(radius - r) - len
+    Some(if inside {
+        (F::splat(radius - r) - len, delta)
     } else {
-        len - F::splat(radius + r)
-    };
-    let hit = dist.lt(zero);
-    // (No closures in the hot path: they would not inherit the AVX2 code generation.)
-    if hit.any() {
-        let dir = delta.normalize_or(V3::splat(Vec3::ZERO));
-        Some((if inside { -dir } else { dir }, dist, hit))
-    } else {
-        None
+        (len - F::splat(radius + r), delta)
+    })
+}
+
+/// The push of the specification's collision: `None` when no lane is in contact, else the
+/// direction, the signed distance and the lanes in contact. The direction (three
+/// divisions and a square root) is computed only when a lane is in contact.
+#[inline(always)]
+fn contact(shape: &VrmShape, placed: &Placed, p: V3, r: f32) -> Option<(V3, F, M)> {
+    let (dist, delta) = distance(shape, placed, p, r)?;
+    let hit = dist.lt(F::splat(0.0));
+    if !hit.any() {
+        return None;
     }
+    let dir = match *shape {
+        VrmShape::Plane { .. } => delta,
+        VrmShape::Sphere { inside, .. } | VrmShape::Capsule { inside, .. } => {
+            let dir = delta.normalize_or(V3::splat(Vec3::ZERO));
+            if inside {
+                -dir
+            } else {
+                dir
+            }
+        }
+    };
+    Some((dir, dist, hit))
+}
+
+/// How far a tail at `p` violates the collider, per lane (≤ 0: not at all), or `None` when
+/// no lane can.
+#[inline(always)]
+fn penetration(shape: &VrmShape, placed: &Placed, p: V3, r: f32) -> Option<F> {
+    distance(shape, placed, p, r).map(|(d, _)| -d)
+}
+
+/// [`crate::dynamics::vrm::PlacedVrmCollider::settle`] per lane.
+#[inline(always)]
+fn settle_one(shape: &VrmShape, placed: &Placed, pos: V3, length: F, tail: V3, r: f32) -> V3 {
+    let zero = F::splat(0.0);
+    let one = F::splat(1.0);
+    let (a, c, valid) = match *shape {
+        VrmShape::Plane { .. } => {
+            let normal = placed.b;
+            let c = (F::splat(r) - (pos - placed.a).dot(normal)) / length;
+            (normal, c, M::ALL)
+        }
+        VrmShape::Sphere { radius, inside, .. } | VrmShape::Capsule { radius, inside, .. } => {
+            let q = match *shape {
+                VrmShape::Capsule { .. } => closest_point_on_segment(tail, placed.a, placed.b),
+                _ => placed.a,
+            };
+            let limit = if inside {
+                (radius - r).max(0.0)
+            } else {
+                radius + r
+            };
+            let d = pos - q;
+            let dl = d.length();
+            let k = (F::splat(limit * limit) - dl * dl - length * length)
+                / (F::splat(2.0) * length * dl);
+            let valid = dl.lt(F::splat(1e-9)).not();
+            if inside {
+                (-d / dl, -k, valid)
+            } else {
+                (d / dl, k, valid)
+            }
+        }
+    };
+    let u = (tail - pos).normalize_or(a);
+    let ua = u.dot(a);
+    let keep = (c - F::splat(1e-6)).le(ua).or(c.lt(F::splat(-1.0)));
+    let straight = pos + a * length;
+    let side = (u - a * ua).normalize_or(a.any_orthonormal());
+    let turned = pos + (a * c + side * (one - c * c).sqrt()) * length;
+    let moved = V3::select(F::splat(1.0).le(c), straight, turned);
+    let unchanged = length.le(zero).or(valid.not()).or(keep);
+    V3::select(unchanged, tail, moved)
+}
+
+/// Whether two per-lane vectors differ (as `Vec3 != Vec3`: by value, `-0 == 0`).
+#[inline(always)]
+fn differs(a: V3, b: V3) -> M {
+    let mut r = [0u32; LANES];
+    for i in 0..LANES {
+        let ne = a.x.0[i] != b.x.0[i] || a.y.0[i] != b.y.0[i] || a.z.0[i] != b.z.0[i];
+        r[i] = if ne { !0 } else { 0 };
+    }
+    M(r)
+}
+
+/// The joints a frame (or a step) works on: the character transform, locals, models.
+struct Poses<'p> {
+    comp: Trs,
+    locals: &'p [Trs],
+    models: &'p mut [Trs],
 }
 
 // `match` rather than `Option::map` in the hot path: a closure is a function of its own,
@@ -702,14 +797,20 @@ impl Ctx<'_> {
     fn step_lanes(&self, pack: &mut Pack, s: &mut Scratch) {
         let plan = self.plan;
         let opts = &self.rig.options;
-        let three = opts.mode == VrmMode::ThreeVrm;
+        let mode = opts.mode;
         let comp = s.component;
+        let fixed = mode == VrmMode::Fixed;
+        if fixed {
+            for lane in 0..LANES {
+                pack.paths[lane].push(comp.get(lane), self.dt);
+            }
+        }
         let mut reset = M::from_bools(pack.needs_reset);
         if opts.teleport_distance > 0.0 {
             let moved = (comp.t - pack.prev_component.t).length();
             reset = reset.or(moved.gt(F::splat(opts.teleport_distance)));
         }
-        // The animated model pose.
+        // The animated model pose (as the single-character frame computes it).
         for k in 0..plan.joints.len() {
             let m = match plan.parent[k] {
                 Some(p) => under(Some(&s.models[p]), &s.locals[k]),
@@ -717,12 +818,25 @@ impl Ctx<'_> {
             };
             s.models[k] = m;
         }
-        if self.dt > 0.0 && reset != M::ALL {
-            self.place_colliders(s);
-            self.update(pack, s, three);
+        if reset != M::ALL {
+            if fixed {
+                self.run_fixed(pack, s, reset);
+            } else if self.dt > 0.0 {
+                let Scratch {
+                    locals,
+                    models,
+                    placed,
+                    ..
+                } = s;
+                let mut poses = Poses {
+                    comp,
+                    locals,
+                    models,
+                };
+                self.place_colliders(&poses, placed);
+                self.update(pack, &mut poses, placed, mode, M::ALL);
+            }
         }
-        // (three-vrm's tails are recorded from the output pose below, as the scalar job
-        // records them after its reset too.)
         // Guard: a non-finite state starts again from the pose.
         let mut bad = M::NONE;
         for i in 0..self.rig.links.len() {
@@ -737,6 +851,7 @@ impl Ctx<'_> {
             for lane in 0..LANES {
                 if again.get(lane) {
                     pack.resets[lane] += 1;
+                    pack.accumulator[lane] = 0.0;
                     // A reset that itself is not finite is reset once more by the guard.
                     if reset.get(lane) && still_bad.get(lane) {
                         pack.resets[lane] += 1;
@@ -744,7 +859,13 @@ impl Ctx<'_> {
                 }
             }
         }
-        if three {
+        if fixed {
+            self.fixed_output(pack, s, again);
+        } else {
+            pack.out_rotation.copy_from_slice(&pack.rotation);
+            pack.rotation_before.copy_from_slice(&pack.rotation);
+        }
+        if mode == VrmMode::ThreeVrm {
             self.record_tails(pack, s);
         }
         pack.prev_component = comp;
@@ -752,10 +873,10 @@ impl Ctx<'_> {
     }
 
     #[inline(always)]
-    fn place_colliders(&self, s: &mut Scratch) {
-        let comp = s.component;
+    fn place_colliders(&self, poses: &Poses, placed: &mut [Placed]) {
+        let comp = poses.comp;
         for (c, (slot, shape)) in self.plan.colliders.iter().enumerate() {
-            let w = comp.mul(&s.models[*slot]);
+            let w = comp.mul(&poses.models[*slot]);
             let zero = V3::splat(Vec3::ZERO);
             let half = F::splat(0.5);
             let (a, b) = match *shape {
@@ -770,7 +891,7 @@ impl Ctx<'_> {
                         .normalize_or(V3::splat(Vec3::Y)),
                 ),
             };
-            s.placed[c] = match *shape {
+            placed[c] = match *shape {
                 VrmShape::Capsule { .. } => Placed {
                     a,
                     b,
@@ -788,24 +909,39 @@ impl Ctx<'_> {
     }
 
     /// The specification's update of every link, one pass in skeleton order (the scalar
-    /// job's lazy refresh: a joint's model is recomputed once everything above it is).
+    /// job's lazy refresh: a joint's model is recomputed once everything above it is; a
+    /// refreshed skeleton root takes its local as its model, as the scalar refresh does).
+    /// Only the lanes in `active` keep the new state.
     #[inline(always)]
-    fn update(&self, pack: &mut Pack, s: &mut Scratch, three: bool) {
+    fn update(
+        &self,
+        pack: &mut Pack,
+        poses: &mut Poses,
+        placed: &[Placed],
+        mode: VrmMode,
+        active: M,
+    ) {
         let plan = self.plan;
         for slot in 0..plan.joints.len() {
             if !plan.affected[slot] {
                 continue;
             }
             let parent = match plan.parent[slot] {
-                Some(p) => Some(s.models[p]),
+                Some(p) => Some(poses.models[p]),
                 None => None,
             };
-            let local = s.locals[slot];
+            let local = poses.locals[slot];
             match plan.link_at[slot] {
-                None => s.models[slot] = under(parent.as_ref(), &local),
+                None => {
+                    poses.models[slot] = match parent {
+                        Some(p) => p.mul(&local),
+                        None => local,
+                    }
+                }
                 Some(i) => {
-                    let (rotation, own_t) = self.link(i, pack, s, parent.as_ref(), three);
-                    s.models[slot] = match parent {
+                    let (rotation, own_t) =
+                        self.link(i, pack, poses, placed, parent.as_ref(), mode, active);
+                    poses.models[slot] = match parent {
                         // `p * turned`, its translation (`own_t`) already computed.
                         Some(p) => Trs {
                             t: own_t,
@@ -824,24 +960,27 @@ impl Ctx<'_> {
     }
 
     /// One link: Verlet step, collisions, the joint turned toward the new tail.
+    #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     fn link(
         &self,
         i: usize,
         pack: &mut Pack,
-        s: &Scratch,
+        poses: &Poses,
+        placed: &[Placed],
         parent: Option<&Trs>,
-        three: bool,
+        mode: VrmMode,
+        active: M,
     ) -> (Q, V3) {
         let lp = &self.plan.links[i];
-        let comp = s.component;
+        let comp = poses.comp;
         let (parent_world, own_t) = match parent {
-            Some(p) => (comp.mul(p), p.transform_point(s.locals[lp.slot].t)),
-            None => (comp, s.models[lp.slot].t),
+            Some(p) => (comp.mul(p), p.transform_point(poses.locals[lp.slot].t)),
+            None => (comp, poses.models[lp.slot].t),
         };
         let position = comp.transform_point(own_t);
         let center = match lp.center {
-            Some(c) => Some(comp.mul(&s.models[c])),
+            Some(c) => Some(comp.mul(&poses.models[c])),
             None => None,
         };
         let (current, prev) = match &center {
@@ -855,34 +994,298 @@ impl Ctx<'_> {
         let inertia = (current - prev) * F::splat(lp.keep);
         let stiffness = rest_dir * F::splat(self.stiffness_dt[i]);
         let external = V3::splat(self.external[i]);
-        let length = match (three, lp.tail_slot) {
-            (true, Some(_)) => (pack.stale_tail[i] - position).length(),
+        let length = match (mode, lp.tail_slot) {
+            (VrmMode::ThreeVrm, Some(_)) => (pack.stale_tail[i] - position).length(),
             _ => pack.length[i],
         };
-        let mut next = position
+        let next = position
             + (current + inertia + stiffness + external - position).normalize_or(rest_dir) * length;
-        for &c in &self.rig.link_colliders[lp.colliders.clone()] {
-            let shape = &self.plan.colliders[c].1;
-            if let Some((dir, dist, hit)) = contact(shape, &s.placed[c], next, lp.hit_radius) {
-                let pushed =
-                    position + (next - dir * dist - position).normalize_or(rest_dir) * length;
-                next = V3::select(hit, pushed, next);
-            }
-        }
-        pack.prev_tail[i] = pack.current_tail[i];
-        pack.current_tail[i] = match &center {
+        let (next, _) = self.collide_tail(
+            lp,
+            placed,
+            position,
+            length,
+            rest_dir,
+            next,
+            mode == VrmMode::Fixed,
+        );
+        let stored = match &center {
             Some(c) => c.inverse_transform_point(next),
             None => next,
         };
         // Turn the joint toward the tail, from its rest frame under the current parent.
+        let rotation = self.turn(lp, &parent_world, next);
+        pack.prev_tail[i] = V3::select(active, pack.current_tail[i], pack.prev_tail[i]);
+        pack.current_tail[i] = V3::select(active, stored, pack.current_tail[i]);
+        pack.rotation[i] = Q::select(active, rotation, pack.rotation[i]);
+        (rotation, own_t)
+    }
+
+    /// The local rotation that points the link's bone at `tail` (world): the rest local
+    /// rotation turned from the bone axis to the tail seen from the rest frame.
+    #[inline(always)]
+    fn turn(&self, lp: &LinkPlan, parent_world: &Trs, tail: V3) -> Q {
         let rest_world = parent_world.mul(&Trs::splat(&lp.rest_local));
         let to = rest_world
-            .inverse_transform_point(next)
+            .inverse_transform_point(tail)
             .normalize_or(V3::splat(lp.bone_axis));
         let arc = rotation_arc_from(lp.arc_from, lp.half_turn, to);
-        let rotation = Q::splat(lp.rest_local.rotation).mul_quat(arc).normalize();
-        pack.rotation[i] = rotation;
-        (rotation, own_t)
+        Q::splat(lp.rest_local.rotation).mul_quat(arc).normalize()
+    }
+
+    /// The specification's collision (one push per collider and the projection back to
+    /// the bone length), then with `exact` the settling of what is left inside. Returns
+    /// the tail and the lanes where a collider acted.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn collide_tail(
+        &self,
+        lp: &LinkPlan,
+        placed: &[Placed],
+        position: V3,
+        length: F,
+        rest_dir: V3,
+        mut tail: V3,
+        exact: bool,
+    ) -> (V3, M) {
+        let mut acted = M::NONE;
+        let colliders = &self.rig.link_colliders[lp.colliders.clone()];
+        for &c in colliders {
+            let shape = &self.plan.colliders[c].1;
+            if let Some((dir, dist, hit)) = contact(shape, &placed[c], tail, lp.hit_radius) {
+                let pushed =
+                    position + (tail - dir * dist - position).normalize_or(rest_dir) * length;
+                tail = V3::select(hit, pushed, tail);
+                acted = acted.or(hit);
+            }
+        }
+        if exact {
+            let zero = F::splat(0.0);
+            for _ in 0..2 {
+                let mut changed = M::NONE;
+                for &c in colliders {
+                    let shape = &self.plan.colliders[c].1;
+                    let Some(before) = penetration(shape, &placed[c], tail, lp.hit_radius) else {
+                        continue;
+                    };
+                    let inside = zero.lt(before);
+                    if !inside.any() {
+                        continue;
+                    }
+                    let t = settle_one(shape, &placed[c], position, length, tail, lp.hit_radius);
+                    let after = match penetration(shape, &placed[c], t, lp.hit_radius) {
+                        Some(p) => p,
+                        None => F::splat(f32::NEG_INFINITY),
+                    };
+                    let better = inside.and(after.lt(before));
+                    changed = changed.or(better.and(differs(t, tail)));
+                    tail = V3::select(better, t, tail);
+                }
+                acted = acted.or(changed);
+                if !changed.any() {
+                    break;
+                }
+            }
+        }
+        (tail, acted)
+    }
+
+    /// Fixed mode: whole steps of `1/step_rate` up to now for the lanes not reset, each
+    /// with the animated pose and the character transform interpolated to its time.
+    #[inline(always)]
+    fn run_fixed(&self, pack: &mut Pack, s: &mut Scratch, reset: M) {
+        let opts = &self.rig.options;
+        let h = 1.0 / opts.step_rate;
+        let dt = self.dt;
+        let mut steps = [0u32; LANES];
+        let mut acc_old = [0.0f32; LANES];
+        let mut skipped = [0.0f32; LANES];
+        let mut most = 0;
+        for lane in 0..LANES {
+            if reset.get(lane) {
+                continue;
+            }
+            let old = pack.accumulator[lane];
+            let mut total = old + dt;
+            let mut n = (total / h + 1e-4).floor() as u32;
+            if n > opts.max_steps_per_frame {
+                // A hitch: drop the time we cannot afford, keep the most recent steps.
+                total -= (n - opts.max_steps_per_frame) as f32 * h;
+                n = opts.max_steps_per_frame;
+            }
+            steps[lane] = n;
+            acc_old[lane] = old;
+            skipped[lane] = old + dt - total;
+            pack.accumulator[lane] = (total - n as f32 * h).max(0.0);
+            most = most.max(n);
+        }
+        let Scratch {
+            locals,
+            step_locals,
+            step_models,
+            placed,
+            ..
+        } = s;
+        for k in 1..=most {
+            let active = M::from_bools(std::array::from_fn(|l| !reset.get(l) && k <= steps[l]));
+            let mut w = [1.0f32; LANES];
+            let mut comp = Trs::splat(&Transform::IDENTITY);
+            for lane in 0..LANES {
+                // Where this step ends between last frame (0) and this frame (1).
+                let end = k as f32 * h - acc_old[lane] + skipped[lane];
+                if dt > 0.0 {
+                    w[lane] = (end / dt).clamp(0.0, 1.0);
+                }
+                comp.set(lane, &pack.paths[lane].at(w[lane]));
+            }
+            let w = F(w);
+            for slot in 0..self.plan.joints.len() {
+                step_locals[slot] = pack.prev_locals[slot].lerp(&locals[slot], w);
+                // The scalar step refreshes every joint, a root as its local.
+                step_models[slot] = match self.plan.parent[slot] {
+                    Some(p) => step_models[p].mul(&step_locals[slot]),
+                    None => step_locals[slot],
+                };
+            }
+            let mut poses = Poses {
+                comp,
+                locals: step_locals,
+                models: step_models,
+            };
+            self.place_colliders(&poses, placed);
+            for i in 0..pack.rotation.len() {
+                pack.rotation_before[i] =
+                    Q::select(active, pack.rotation[i], pack.rotation_before[i]);
+            }
+            self.update(pack, &mut poses, placed, VrmMode::Fixed, active);
+        }
+    }
+
+    /// Fixed mode's output: the rotations between the last two steps, pushed out of this
+    /// frame's colliders; and this frame's pose kept for the next frame's steps.
+    #[inline(always)]
+    fn fixed_output(&self, pack: &mut Pack, s: &mut Scratch, reset: M) {
+        let plan = self.plan;
+        let opts = &self.rig.options;
+        // Last frame's pose for the next steps: the animated locals, with the rest
+        // rotations a reset wrote into the spring joints.
+        for slot in 0..plan.joints.len() {
+            let mut kept = s.locals[slot];
+            if let Some(i) = plan.link_at[slot] {
+                kept.r = Q::select(reset, Q::splat(plan.links[i].rest_local.rotation), kept.r);
+            }
+            pack.prev_locals[slot] = kept;
+        }
+        // This frame's colliders: from the animated pose (the reset's pose where reset).
+        for slot in 0..plan.joints.len() {
+            let m = s.models[slot];
+            s.step_models[slot] = Trs {
+                t: V3::select(reset, s.reset_models[slot].t, m.t),
+                r: Q::select(reset, s.reset_models[slot].r, m.r),
+                s: V3::select(reset, s.reset_models[slot].s, m.s),
+            };
+        }
+        let comp = s.component;
+        {
+            let poses = Poses {
+                comp,
+                locals: &s.locals,
+                models: &mut s.step_models,
+            };
+            self.place_colliders(&poses, &mut s.placed);
+        }
+        let mut w = [0.0f32; LANES];
+        for lane in 0..LANES {
+            w[lane] = (pack.accumulator[lane] * opts.step_rate).clamp(0.0, 1.0);
+        }
+        let w = F(w);
+        let full = F::splat(1.0).le(w);
+        for i in 0..pack.rotation.len() {
+            let between = pack.rotation_before[i].slerp_shortest(pack.rotation[i], w);
+            pack.out_rotation[i] = Q::select(full, pack.rotation[i], between);
+        }
+        // The output pose (identity above the roots, as the frame's last model pass).
+        for slot in 0..plan.joints.len() {
+            let mut local = s.locals[slot];
+            if let Some(i) = plan.link_at[slot] {
+                local.r = pack.out_rotation[i];
+            }
+            s.step_locals[slot] = local;
+            let m = match plan.parent[slot] {
+                Some(p) => under(Some(&s.models[p]), &local),
+                None => under(None, &local),
+            };
+            s.models[slot] = m;
+        }
+        if self.rig.link_colliders.is_empty() {
+            return;
+        }
+        // The interpolated pose may cut through a collider between two steps: each tail is
+        // pushed out by this frame's colliders, the rotation rewritten (lanes that acted).
+        let mut acted_any = M::NONE;
+        for slot in 0..plan.joints.len() {
+            let parent = match plan.parent[slot] {
+                Some(p) => Some(s.models[p]),
+                None => None,
+            };
+            if acted_any.any() {
+                // The scalar job's refresh below a changed joint (a root: its local).
+                let local = s.step_locals[slot];
+                s.models[slot] = match parent {
+                    Some(p) => p.mul(&local),
+                    None => {
+                        let m = s.models[slot];
+                        Trs {
+                            t: V3::select(acted_any, local.t, m.t),
+                            r: Q::select(acted_any, local.r, m.r),
+                            s: V3::select(acted_any, local.s, m.s),
+                        }
+                    }
+                };
+            }
+            let Some(i) = plan.link_at[slot] else {
+                continue;
+            };
+            let lp = &plan.links[i];
+            if lp.colliders.is_empty() {
+                continue;
+            }
+            let joint_world = comp.mul(&s.models[slot]);
+            let tail = joint_world.transform_point(V3::splat(lp.tail_local));
+            let parent_world = match &parent {
+                Some(p) => comp.mul(p),
+                None => comp,
+            };
+            let rest_dir = parent_world.r.mul_vec3(V3::splat(lp.rest_bone));
+            let (next, acted) = self.collide_tail(
+                lp,
+                &s.placed,
+                joint_world.t,
+                pack.length[i],
+                rest_dir,
+                tail,
+                true,
+            );
+            if !acted.any() {
+                continue;
+            }
+            let rotation = self.turn(lp, &parent_world, next);
+            pack.out_rotation[i] = Q::select(acted, rotation, pack.out_rotation[i]);
+            let mut local = s.step_locals[slot];
+            local.r = pack.out_rotation[i];
+            s.step_locals[slot] = local;
+            let turned = match parent {
+                Some(p) => p.mul(&local),
+                None => local,
+            };
+            let m = s.models[slot];
+            s.models[slot] = Trs {
+                t: V3::select(acted, turned.t, m.t),
+                r: Q::select(acted, turned.r, m.r),
+                s: V3::select(acted, turned.s, m.s),
+            };
+            acted_any = acted_any.or(acted);
+        }
     }
 
     /// The specification's initialisation for the lanes in `lanes`: joints at their rest
@@ -917,6 +1320,7 @@ impl Ctx<'_> {
             pack.current_tail[i] = V3::select(lanes, stored, pack.current_tail[i]);
             pack.prev_tail[i] = V3::select(lanes, stored, pack.prev_tail[i]);
             pack.rotation[i] = Q::select(lanes, rest, pack.rotation[i]);
+            pack.rotation_before[i] = Q::select(lanes, rest, pack.rotation_before[i]);
             bad = bad.or(stored.finite().not());
         }
         bad
@@ -933,7 +1337,7 @@ impl Ctx<'_> {
             }
             let mut local = s.locals[slot];
             if let Some(i) = plan.link_at[slot] {
-                local.r = pack.rotation[i];
+                local.r = pack.out_rotation[i];
             }
             let m = match plan.parent[slot] {
                 Some(p) => under(Some(&s.models[p]), &local),

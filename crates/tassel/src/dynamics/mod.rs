@@ -8,7 +8,7 @@ pub mod cloth;
 mod curve;
 mod mode;
 pub mod particles;
-mod path;
+pub(crate) mod path;
 mod rig;
 pub mod rope;
 pub mod spring;
