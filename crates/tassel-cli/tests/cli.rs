@@ -442,6 +442,39 @@ fn bench_crowd_and_cloth() {
             && last.ends_with(" ns per joint-step"),
         "{last}"
     );
+    // VRM springs go through the crowd path; --compare times the single-character path
+    // in the same run and says the ratio before the last line.
+    let out = tassel()
+        .args([
+            "bench",
+            "--vrm",
+            "fixed",
+            "--crowd",
+            "9",
+            "--compare",
+            "--frames",
+            "5",
+            "--runs",
+            "1",
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let lines: Vec<&str> = stdout.lines().collect();
+    assert!(lines[0].contains("crowd path"), "{stdout}");
+    assert!(
+        lines[lines.len() - 2].contains("the crowd path is"),
+        "{stdout}"
+    );
+    assert!(
+        lines[lines.len() - 1].starts_with("crowd: 9 characters x 112 joints, 1 threads: "),
+        "{stdout}"
+    );
     let out = tassel()
         .args(["bench", "--cloth", "--frames", "5", "--runs", "1"])
         .output()

@@ -613,7 +613,9 @@ impl F {
     }
 }
 
-/// glam's scalar `acos_approx` (DirectXMath's 7th-degree minimax), per lane.
+/// glam's scalar `acos_approx` (DirectXMath's 7th-degree minimax), per lane, with glam's
+/// constants as glam writes them.
+#[allow(clippy::approx_constant)]
 #[inline(always)]
 fn acos_approx(v: F) -> F {
     let nonnegative = F::splat(0.0).le(v);
