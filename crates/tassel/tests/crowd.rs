@@ -313,3 +313,79 @@ fn vrm_crowd_rejects_bad_input_by_character() {
         .unwrap();
     assert!(crowd.rotation(20, 0).is_none() && crowd.reset(20).is_err());
 }
+
+/// Characters removed mid-run (`swap_remove`, the last taking the index) and added again:
+/// everyone left carries on with the bits of their own `CharacterSim`, and a character
+/// added into a freed lane starts afresh.
+#[test]
+fn vrm_crowd_removes_and_adds_characters() {
+    let (sk, bones) = builtin::bench_vrm(6, 5, 8);
+    for (mode, step_rate) in [(VrmMode::Spec, 60.0), (VrmMode::Fixed, 90.0)] {
+        let options = VrmOptions {
+            mode,
+            step_rate,
+            ..Default::default()
+        };
+        let rig = Arc::new(VrmRig::new(&sk, &bones, options).unwrap());
+        let mut crowd = VrmCrowd::new(Arc::new(sk.clone()), rig).unwrap();
+        let new_sim = || {
+            CharacterSim::with_vrm(sk.clone(), &RigSettings::default(), &bones, options).unwrap()
+        };
+        // (identity for the motion's phase, its own simulation), in crowd index order.
+        let mut people: Vec<(usize, CharacterSim)> = (0..17).map(|id| (id, new_sim())).collect();
+        for _ in 0..17 {
+            crowd.add();
+        }
+        let mut next_id = 17;
+        let mut inputs: Vec<(Transform, Vec<Transform>)> = Vec::new();
+        let (mut locals, mut models) = (sk.rest().to_vec(), sk.rest().to_vec());
+        for f in 0..300 {
+            match f {
+                100 => {
+                    for i in [3, 15, 0, 8] {
+                        crowd.swap_remove(i).unwrap();
+                        people.swap_remove(i);
+                    }
+                }
+                150 => {
+                    for _ in 0..3 {
+                        assert_eq!(crowd.add(), people.len());
+                        people.push((next_id, new_sim()));
+                        next_id += 1;
+                    }
+                    assert_eq!(crowd.reset_count(people.len() - 1), Some(0));
+                }
+                _ => {}
+            }
+            assert_eq!(crowd.len(), people.len());
+            inputs.resize(people.len(), (Transform::IDENTITY, sk.rest().to_vec()));
+            for (k, (id, _)) in people.iter().enumerate() {
+                let (t, l) = &mut inputs[k];
+                *t = motion(&sk, 1, *id, f, l);
+            }
+            crowd
+                .frame(1.0 / 60.0, |i| CrowdPose {
+                    transform: inputs[i].0,
+                    locals: &inputs[i].1,
+                })
+                .unwrap();
+            for (k, (id, sim)) in people.iter_mut().enumerate() {
+                let pose = sim.frame(&inputs[k].1, inputs[k].0, 1.0 / 60.0).unwrap();
+                locals.copy_from_slice(&inputs[k].1);
+                crowd.write_pose(k, &mut locals, &mut models).unwrap();
+                for j in 0..sk.len() {
+                    assert_eq!(
+                        bits(&locals[j]),
+                        bits(&pose.locals[j]),
+                        "{mode:?} frame {f}: character {id} at index {k}, joint {j}"
+                    );
+                }
+            }
+        }
+        assert!(crowd.swap_remove(crowd.len()).is_err());
+        while !crowd.is_empty() {
+            crowd.swap_remove(0).unwrap();
+        }
+        crowd.frame(1.0 / 60.0, |_| unreachable!()).unwrap();
+    }
+}

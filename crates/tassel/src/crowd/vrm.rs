@@ -209,6 +209,76 @@ struct Placed {
     half: F,
 }
 
+/// One character's state, taken out of its lane (to move it to another).
+#[derive(Debug, Clone)]
+struct LaneState {
+    current_tail: Vec<Vec3>,
+    prev_tail: Vec<Vec3>,
+    length: Vec<f32>,
+    stale_tail: Vec<Vec3>,
+    rotation: Vec<Quat>,
+    rotation_before: Vec<Quat>,
+    out_rotation: Vec<Quat>,
+    prev_locals: Vec<Transform>,
+    path: CharacterPath,
+    accumulator: f32,
+    prev_component: Transform,
+    needs_reset: bool,
+    resets: u64,
+}
+
+impl Pack {
+    fn lane(&self, l: usize) -> LaneState {
+        LaneState {
+            current_tail: self.current_tail.iter().map(|v| v.get(l)).collect(),
+            prev_tail: self.prev_tail.iter().map(|v| v.get(l)).collect(),
+            length: self.length.iter().map(|v| v.get(l)).collect(),
+            stale_tail: self.stale_tail.iter().map(|v| v.get(l)).collect(),
+            rotation: self.rotation.iter().map(|q| q.get(l)).collect(),
+            rotation_before: self.rotation_before.iter().map(|q| q.get(l)).collect(),
+            out_rotation: self.out_rotation.iter().map(|q| q.get(l)).collect(),
+            prev_locals: self.prev_locals.iter().map(|t| t.get(l)).collect(),
+            path: self.paths[l],
+            accumulator: self.accumulator[l],
+            prev_component: self.prev_component.get(l),
+            needs_reset: self.needs_reset[l],
+            resets: self.resets[l],
+        }
+    }
+
+    fn set_lane(&mut self, l: usize, s: &LaneState) {
+        for (d, v) in self.current_tail.iter_mut().zip(&s.current_tail) {
+            d.set(l, *v);
+        }
+        for (d, v) in self.prev_tail.iter_mut().zip(&s.prev_tail) {
+            d.set(l, *v);
+        }
+        for (d, v) in self.length.iter_mut().zip(&s.length) {
+            d.0[l] = *v;
+        }
+        for (d, v) in self.stale_tail.iter_mut().zip(&s.stale_tail) {
+            d.set(l, *v);
+        }
+        for (d, q) in self.rotation.iter_mut().zip(&s.rotation) {
+            d.set(l, *q);
+        }
+        for (d, q) in self.rotation_before.iter_mut().zip(&s.rotation_before) {
+            d.set(l, *q);
+        }
+        for (d, q) in self.out_rotation.iter_mut().zip(&s.out_rotation) {
+            d.set(l, *q);
+        }
+        for (d, t) in self.prev_locals.iter_mut().zip(&s.prev_locals) {
+            d.set(l, t);
+        }
+        self.paths[l] = s.path;
+        self.accumulator[l] = s.accumulator;
+        self.prev_component.set(l, &s.prev_component);
+        self.needs_reset[l] = s.needs_reset;
+        self.resets[l] = s.resets;
+    }
+}
+
 /// One thread's working buffers.
 #[derive(Debug, Clone)]
 struct Scratch {
@@ -337,9 +407,33 @@ impl VrmCrowd {
         let i = self.len;
         let pack = &mut self.packs[i / LANES];
         pack.count += 1;
-        pack.needs_reset[i % LANES] = true;
+        // A lane a removed character left: start it afresh.
+        let lane = i % LANES;
+        pack.needs_reset[lane] = true;
+        pack.resets[lane] = 0;
+        pack.accumulator[lane] = 0.0;
+        pack.paths[lane] = CharacterPath::default();
         self.len += 1;
         i
+    }
+
+    /// Removes character `i`; the last character takes its index (as `Vec::swap_remove`),
+    /// and carries on exactly as it would have.
+    pub fn swap_remove(&mut self, i: usize) -> Result<()> {
+        self.check(i)?;
+        let last = self.len - 1;
+        if i != last {
+            let moved = self.packs[last / LANES].lane(last % LANES);
+            self.packs[i / LANES].set_lane(i % LANES, &moved);
+        }
+        let pack = &mut self.packs[last / LANES];
+        pack.count -= 1;
+        pack.needs_reset[last % LANES] = true;
+        if pack.count == 0 {
+            self.packs.pop();
+        }
+        self.len -= 1;
+        Ok(())
     }
 
     /// Allows (the default) or forbids the AVX2 code path on CPUs that have it. The results
