@@ -78,15 +78,8 @@ fn character(a: &Args) -> Result<(CharacterSim, usize, String), String> {
         }
         Some(m) => {
             let (_, bones) = builtin::bench_vrm(chains, joints, colliders);
-            let mode = match m {
-                VrmBenchMode::Spec => VrmMode::Spec,
-                VrmBenchMode::Fixed => VrmMode::Fixed,
-                VrmBenchMode::ThreeVrm => VrmMode::ThreeVrm,
-            };
-            let options = VrmOptions {
-                mode,
-                ..Default::default()
-            };
+            let options = vrm_options(m);
+            let mode = options.mode;
             let sim = CharacterSim::with_vrm(sk, &RigSettings::default(), &bones, options)
                 .map_err(|e| e.to_string())?;
             let simulated = sim.vrm().links.len();
@@ -97,6 +90,34 @@ fn character(a: &Args) -> Result<(CharacterSim, usize, String), String> {
             ))
         }
     }
+}
+
+/// The bench's VRM options in mode `m`.
+fn vrm_options(m: VrmBenchMode) -> VrmOptions {
+    VrmOptions {
+        mode: match m {
+            VrmBenchMode::Spec => VrmMode::Spec,
+            VrmBenchMode::Fixed => VrmMode::Fixed,
+            VrmBenchMode::ThreeVrm => VrmMode::ThreeVrm,
+        },
+        ..Default::default()
+    }
+}
+
+/// One warm-up run of a quarter of `frames`, then `runs` runs of `frames`: the samples
+/// `one_run(frames)` returns, sorted.
+fn sorted_samples(
+    runs: usize,
+    frames: usize,
+    mut one_run: impl FnMut(usize) -> Result<f64, String>,
+) -> Result<Vec<f64>, String> {
+    one_run(frames / 4 + 1)?; // warm up
+    let mut samples = Vec::new();
+    for _ in 0..runs.max(1) {
+        samples.push(one_run(frames.max(1))?);
+    }
+    samples.sort_by(|x, y| x.total_cmp(y));
+    Ok(samples)
 }
 
 /// The bench motion of a character with phase `phase` at frame `f`.
@@ -122,12 +143,7 @@ pub fn run(a: Args) -> Result<(), String> {
         }
         Ok(start.elapsed().as_nanos() as f64 / (frames * simulated) as f64)
     };
-    one_run(a.frames / 4 + 1)?; // warm up
-    let mut samples = Vec::new();
-    for _ in 0..a.runs.max(1) {
-        samples.push(one_run(a.frames.max(1))?);
-    }
-    samples.sort_by(|x, y| x.total_cmp(y));
+    let samples = sorted_samples(a.runs, a.frames, &mut one_run)?;
     let median = samples[samples.len() / 2];
     say!("tassel bench: {what}, single thread");
     say!(
@@ -202,15 +218,7 @@ fn vrm_crowd(
 ) -> Result<(String, usize, f64), String> {
     let (_, joints, what) = character(a)?;
     let (sk, bones) = builtin::bench_vrm(16, 8, 8);
-    let mode = match a.vrm {
-        Some(VrmBenchMode::ThreeVrm) => VrmMode::ThreeVrm,
-        Some(VrmBenchMode::Fixed) => VrmMode::Fixed,
-        _ => VrmMode::Spec,
-    };
-    let options = VrmOptions {
-        mode,
-        ..Default::default()
-    };
+    let options = vrm_options(a.vrm.unwrap_or(VrmBenchMode::Spec));
     let rig = VrmRig::new(&sk, &bones, options).map_err(|e| e.to_string())?;
     let rest = sk.rest().to_vec();
     let mut crowd = VrmCrowd::new(Arc::new(sk), Arc::new(rig)).map_err(|e| e.to_string())?;
@@ -223,7 +231,7 @@ fn vrm_crowd(
         .map_err(|e| e.to_string())?;
     let dt = 1.0 / 60.0;
     let mut first_frame = 0usize;
-    let mut one_run = |frames: usize| -> Result<f64, String> {
+    let one_run = |frames: usize| -> Result<f64, String> {
         let start = Instant::now();
         pool.install(|| -> Result<(), String> {
             for f in first_frame..first_frame + frames {
@@ -239,12 +247,7 @@ fn vrm_crowd(
         first_frame += frames;
         Ok(start.elapsed().as_secs_f64() / frames as f64)
     };
-    one_run(frames / 4 + 1)?; // warm up
-    let mut samples = Vec::new();
-    for _ in 0..a.runs.max(1) {
-        samples.push(one_run(frames)?);
-    }
-    samples.sort_by(|x, y| x.total_cmp(y));
+    let samples = sorted_samples(a.runs, frames, one_run)?;
     Ok((what, joints, samples[samples.len() / 2]))
 }
 
@@ -297,11 +300,6 @@ fn sims_crowd(
         first_frame += frames;
         Ok(start.elapsed().as_secs_f64() / frames as f64)
     };
-    one_run(&mut sims, frames / 4 + 1)?; // warm up
-    let mut samples = Vec::new();
-    for _ in 0..a.runs.max(1) {
-        samples.push(one_run(&mut sims, frames)?);
-    }
-    samples.sort_by(|x, y| x.total_cmp(y));
+    let samples = sorted_samples(a.runs, frames, |frames| one_run(&mut sims, frames))?;
     Ok((what, joints, samples[samples.len() / 2]))
 }

@@ -4,32 +4,14 @@
 
 mod common;
 
-use common::testdata;
+use common::{testdata, vrm_files};
 use glam::{Quat, Vec3};
-use std::path::PathBuf;
 use std::sync::Arc;
 use tassel::crowd::{CrowdPose, VrmCrowd};
 use tassel::dynamics::vrm::{VrmMode, VrmOptions, VrmRig, VrmSpringBones};
 use tassel::dynamics::RigSettings;
 use tassel::{CharacterSim, Skeleton, Transform};
 use tassel_gltf::Model;
-
-fn vrm_files() -> Vec<PathBuf> {
-    let Some(dir) = testdata("vrm") else {
-        return vec![];
-    };
-    let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| matches!(p.extension().and_then(|e| e.to_str()), Some("vrm" | "gltf")))
-        .collect();
-    files.sort();
-    assert!(
-        files.len() >= 8,
-        "expected the 8 VRM fixtures, found {files:?}"
-    );
-    files
-}
 
 /// Character `i` at frame `f`: its own phase of a sway that rolls it over (so that gravity
 /// throws the springs against the colliders), joint 0 and the first spring joint's parent

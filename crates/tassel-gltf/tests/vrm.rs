@@ -5,30 +5,13 @@
 
 mod common;
 
-use common::testdata;
+use common::{testdata, vrm_files};
 use glam::{Quat, Vec3};
 use serde_json::Value;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use tassel::dynamics::vrm::*;
 use tassel::{Pose, Transform};
 use tassel_gltf::{Model, VrmVersion};
-
-fn vrm_files() -> Vec<PathBuf> {
-    let Some(dir) = testdata("vrm") else {
-        return vec![];
-    };
-    let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| matches!(p.extension().and_then(|e| e.to_str()), Some("vrm" | "gltf")))
-        .collect();
-    files.sort();
-    assert!(
-        files.len() >= 8,
-        "expected the 8 VRM fixtures, found {files:?}"
-    );
-    files
-}
 
 /// The document's JSON, read here independently of the importer.
 fn json_of(path: &Path) -> Value {

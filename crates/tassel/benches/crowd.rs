@@ -1,7 +1,7 @@
 //! Criterion bench: one 60 Hz frame of 64 bench characters (16 chains × 8 joints as VRM
 //! springs, 8 colliders, spec mode) through the crowd path and, in the same run, through
-//! one `CharacterSim` each (the single-character reference). Single thread. Throughput
-//! is reported per simulated joint.
+//! one `CharacterSim` each (the single-character reference); the crowd path also with AVX2
+//! forbidden. Single thread. Throughput is reported per simulated joint.
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use std::hint::black_box;
@@ -30,25 +30,29 @@ fn vrm_crowd(c: &mut Criterion) {
         .unwrap();
     let mut g = c.benchmark_group("vrm_crowd_64");
     g.throughput(Throughput::Elements(joints));
-    let mut crowd = VrmCrowd::new(Arc::new(sk.clone()), rig.clone()).unwrap();
-    for _ in 0..N {
-        crowd.add();
-    }
     let mut f = 0u32;
-    g.bench_function("crowd_path", |b| {
-        b.iter(|| {
-            f += 1;
-            pool.install(|| {
-                crowd
-                    .frame(1.0 / 60.0, |i| CrowdPose {
-                        transform: at(f, i),
-                        locals: &rest,
-                    })
-                    .unwrap()
-            });
-            black_box(crowd.rotation(0, 0));
-        })
-    });
+    // The AVX2 path (where the CPU has it) and the baseline SSE2 path: the same bits.
+    for (name, avx2) in [("crowd_path", true), ("crowd_path_sse2", false)] {
+        let mut crowd = VrmCrowd::new(Arc::new(sk.clone()), rig.clone()).unwrap();
+        crowd.set_avx2(avx2);
+        for _ in 0..N {
+            crowd.add();
+        }
+        g.bench_function(name, |b| {
+            b.iter(|| {
+                f += 1;
+                pool.install(|| {
+                    crowd
+                        .frame(1.0 / 60.0, |i| CrowdPose {
+                            transform: at(f, i),
+                            locals: &rest,
+                        })
+                        .unwrap()
+                });
+                black_box(crowd.rotation(0, 0));
+            })
+        });
+    }
     let mut sims: Vec<CharacterSim> = (0..N)
         .map(|_| {
             CharacterSim::with_vrm(sk.clone(), &RigSettings::default(), &bones, options).unwrap()

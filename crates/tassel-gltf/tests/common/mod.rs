@@ -17,6 +17,25 @@ pub fn testdata(rel: &str) -> Option<PathBuf> {
     None
 }
 
+/// The VRM fixtures of `../shared/testdata/vrm` (`.vrm` and `.gltf`), sorted; empty when
+/// the test data is missing (see [`testdata`]).
+pub fn vrm_files() -> Vec<PathBuf> {
+    let Some(dir) = testdata("vrm") else {
+        return vec![];
+    };
+    let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| matches!(p.extension().and_then(|e| e.to_str()), Some("vrm" | "gltf")))
+        .collect();
+    files.sort();
+    assert!(
+        files.len() >= 8,
+        "expected the 8 VRM fixtures, found {files:?}"
+    );
+    files
+}
+
 /// Runs the Khronos validator on `file`; returns (errors, report text), or `None` when the
 /// validator is not installed (`npm ci` in tools/) and `TASSEL_REQUIRE_VALIDATOR` is unset.
 pub fn validate(file: &Path) -> Option<(u64, String)> {

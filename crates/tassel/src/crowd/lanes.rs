@@ -541,6 +541,16 @@ impl Trs {
         }
     }
 
+    /// `m ? a : b` per lane.
+    #[inline(always)]
+    pub fn select(m: M, a: &Trs, b: &Trs) -> Trs {
+        Trs {
+            t: V3::select(m, a.t, b.t),
+            r: Q::select(m, a.r, b.r),
+            s: V3::select(m, a.s, b.s),
+        }
+    }
+
     /// Lane `i`.
     #[inline(always)]
     pub fn get(&self, i: usize) -> Transform {

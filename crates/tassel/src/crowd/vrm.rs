@@ -158,7 +158,7 @@ struct Pack {
     length: Vec<F>,
     stale_tail: Vec<V3>,
     rotation: Vec<Q>,
-    /// Fixed mode: the rotations one step before `rotation`.
+    /// Fixed mode: the rotations one step before `rotation` (unused in the other modes).
     rotation_before: Vec<Q>,
     /// The rotations the last frame wrote (fixed mode: between the last two steps).
     out_rotation: Vec<Q>,
@@ -709,12 +709,12 @@ impl Ctx<'_> {
     }
 }
 
-/// The model transform of a slot from its parent's (`None`: a skeleton root, under the
-/// identity as [`LocalToModelJob`] puts it).
+/// The model transform of a slot with `local` under its parent's model in `models`
+/// (`None`: a skeleton root, under the identity as [`LocalToModelJob`] puts it).
 #[inline(always)]
-fn under(parent: Option<&Trs>, local: &Trs) -> Trs {
+fn under(models: &[Trs], parent: Option<usize>, local: &Trs) -> Trs {
     match parent {
-        Some(p) => p.mul(local),
+        Some(p) => models[p].mul(local),
         None => Trs::splat(&Transform::IDENTITY).mul(local),
     }
 }
@@ -865,7 +865,7 @@ struct Poses<'p> {
 #[allow(clippy::manual_map)]
 impl Ctx<'_> {
     /// One frame of one lane group whose input is in `s`: with AVX2 where the CPU has it
-    /// (twice the lanes per instruction: 1.8× faster measured on `tassel bench --crowd`),
+    /// (twice the lanes per instruction: 1.5× faster, `cargo bench -p tassel --bench crowd`),
     /// else with the baseline SSE2. Both compile the same code, whose every operation is
     /// IEEE-exact per lane, so both give the same bits.
     fn step(&self, pack: &mut Pack, s: &mut Scratch) {
@@ -906,11 +906,7 @@ impl Ctx<'_> {
         }
         // The animated model pose (as the single-character frame computes it).
         for k in 0..plan.joints.len() {
-            let m = match plan.parent[k] {
-                Some(p) => under(Some(&s.models[p]), &s.locals[k]),
-                None => under(None, &s.locals[k]),
-            };
-            s.models[k] = m;
+            s.models[k] = under(&s.models, plan.parent[k], &s.locals[k]);
         }
         if reset != M::ALL {
             if fixed {
@@ -957,7 +953,6 @@ impl Ctx<'_> {
             self.fixed_output(pack, s, again);
         } else {
             pack.out_rotation.copy_from_slice(&pack.rotation);
-            pack.rotation_before.copy_from_slice(&pack.rotation);
         }
         if mode == VrmMode::ThreeVrm {
             self.record_tails(pack, s);
@@ -1272,12 +1267,7 @@ impl Ctx<'_> {
         }
         // This frame's colliders: from the animated pose (the reset's pose where reset).
         for slot in 0..plan.joints.len() {
-            let m = s.models[slot];
-            s.step_models[slot] = Trs {
-                t: V3::select(reset, s.reset_models[slot].t, m.t),
-                r: Q::select(reset, s.reset_models[slot].r, m.r),
-                s: V3::select(reset, s.reset_models[slot].s, m.s),
-            };
+            s.step_models[slot] = Trs::select(reset, &s.reset_models[slot], &s.models[slot]);
         }
         let comp = s.component;
         {
@@ -1298,19 +1288,7 @@ impl Ctx<'_> {
             let between = pack.rotation_before[i].slerp_shortest(pack.rotation[i], w);
             pack.out_rotation[i] = Q::select(full, pack.rotation[i], between);
         }
-        // The output pose (identity above the roots, as the frame's last model pass).
-        for slot in 0..plan.joints.len() {
-            let mut local = s.locals[slot];
-            if let Some(i) = plan.link_at[slot] {
-                local.r = pack.out_rotation[i];
-            }
-            s.step_locals[slot] = local;
-            let m = match plan.parent[slot] {
-                Some(p) => under(Some(&s.models[p]), &local),
-                None => under(None, &local),
-            };
-            s.models[slot] = m;
-        }
+        self.output_pose(pack, s);
         if self.rig.link_colliders.is_empty() {
             return;
         }
@@ -1327,14 +1305,7 @@ impl Ctx<'_> {
                 let local = s.step_locals[slot];
                 s.models[slot] = match parent {
                     Some(p) => p.mul(&local),
-                    None => {
-                        let m = s.models[slot];
-                        Trs {
-                            t: V3::select(acted_any, local.t, m.t),
-                            r: Q::select(acted_any, local.r, m.r),
-                            s: V3::select(acted_any, local.s, m.s),
-                        }
-                    }
+                    None => Trs::select(acted_any, &local, &s.models[slot]),
                 };
             }
             let Some(i) = plan.link_at[slot] else {
@@ -1372,12 +1343,7 @@ impl Ctx<'_> {
                 Some(p) => p.mul(&local),
                 None => local,
             };
-            let m = s.models[slot];
-            s.models[slot] = Trs {
-                t: V3::select(acted, turned.t, m.t),
-                r: Q::select(acted, turned.r, m.r),
-                s: V3::select(acted, turned.s, m.s),
-            };
+            s.models[slot] = Trs::select(acted, &turned, &s.models[slot]);
             acted_any = acted_any.or(acted);
         }
     }
@@ -1420,26 +1386,31 @@ impl Ctx<'_> {
         bad
     }
 
-    /// three-vrm mode: where each tail node is at the end of the frame (the output pose).
+    /// The frame's output pose in `s`: `step_locals` the animated locals with the springs'
+    /// output rotations, `models` their model transforms (identity above the roots, as the
+    /// frame's last model pass) where a spring can move them; the other slots keep the
+    /// animated models already in `models`.
     #[inline(always)]
-    fn record_tails(&self, pack: &mut Pack, s: &mut Scratch) {
+    fn output_pose(&self, pack: &Pack, s: &mut Scratch) {
         let plan = self.plan;
-        let comp = s.component;
         for slot in 0..plan.joints.len() {
-            if !plan.affected[slot] {
-                continue;
-            }
             let mut local = s.locals[slot];
             if let Some(i) = plan.link_at[slot] {
                 local.r = pack.out_rotation[i];
             }
-            let m = match plan.parent[slot] {
-                Some(p) => under(Some(&s.models[p]), &local),
-                None => under(None, &local),
-            };
-            s.models[slot] = m;
+            s.step_locals[slot] = local;
+            if plan.affected[slot] {
+                s.models[slot] = under(&s.models, plan.parent[slot], &local);
+            }
         }
-        for (i, lp) in plan.links.iter().enumerate() {
+    }
+
+    /// three-vrm mode: where each tail node is at the end of the frame (the output pose).
+    #[inline(always)]
+    fn record_tails(&self, pack: &mut Pack, s: &mut Scratch) {
+        self.output_pose(pack, s);
+        let comp = s.component;
+        for (i, lp) in self.plan.links.iter().enumerate() {
             pack.stale_tail[i] = match lp.tail_slot {
                 Some(t) => comp.transform_point(s.models[t].t),
                 None => comp
