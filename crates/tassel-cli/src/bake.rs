@@ -58,7 +58,7 @@ pub fn run(a: Args) -> Result<(), String> {
     let model = tassel_gltf::load(&a.input).map_err(|e| e.to_string())?;
     let sources = choose_clips(&model, &a)?;
     let mut sim = build_sim(&model, a.rig.as_ref(), a.mode, &a.input)?;
-    let joints = sim.simulated_joints();
+    let joints = sim.simulated_joints().to_vec();
     if joints.is_empty() {
         return Err(format!(
             "{}: nothing to bake: the rig and the file's VRM springs simulate no bone",

@@ -148,8 +148,8 @@ pub fn run(a: Args) -> Result<(), String> {
             rot_keys[j].push(l.rotation);
             tr_keys[j].push(l.translation);
         }
-        let out = sim.state().output_positions();
-        let targets = sim.state().target_positions();
+        let out = sim.chain_state().output_positions();
+        let targets = sim.chain_state().target_positions();
         let cloth_out = sim.cloth_state().output_positions();
         let cloth_targets = sim.cloth_state().target_positions();
         for (k, name) in tracked.iter().enumerate() {
@@ -214,7 +214,7 @@ pub fn run(a: Args) -> Result<(), String> {
                 }
             }
             let mut circles = Vec::new();
-            for col in sim.state().placed_colliders() {
+            for col in sim.chain_state().placed_colliders() {
                 let centre = view(col.transform.translation);
                 match col.shape {
                     Shape::Sphere { radius, .. } => circles.push((centre, radius)),
@@ -320,7 +320,7 @@ pub fn run(a: Args) -> Result<(), String> {
     );
     say!(
         "  teleport resets: {} (chains), {} (cloths)",
-        sim.state().teleport_count(),
+        sim.chain_state().teleport_count(),
         sim.cloth_state().reset_count()
     );
     say!("  states: {} ({events} events)", visited.join(" > "));

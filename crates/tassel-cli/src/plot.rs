@@ -81,7 +81,7 @@ pub fn run(a: Args) -> Result<(), String> {
                 .chain(probe.vrm().simulated_joints())
                 .collect();
             if tips.is_empty() {
-                tips = simulated.clone();
+                tips = simulated.to_vec();
             }
             *tips
                 .iter()

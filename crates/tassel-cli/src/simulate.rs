@@ -248,7 +248,9 @@ pub fn run(a: Args) -> Result<(), String> {
             let tail_pos = match tail {
                 Tail::Joint(t) => comp.transform_point(models[t].translation),
                 Tail::Local(p) => w.transform_point(p),
-                Tail::ChainPoint(p) => comp.transform_point(sim.state().output_positions()[p]),
+                Tail::ChainPoint(p) => {
+                    comp.transform_point(sim.chain_state().output_positions()[p])
+                }
                 Tail::ClothPoint(p, length) => {
                     let toward = sim.cloth_state().world_positions()[p] - w.translation;
                     w.translation + toward.normalize_or_zero() * length

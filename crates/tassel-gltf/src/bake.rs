@@ -261,7 +261,7 @@ pub fn bake_clip(
     };
     let name = source.name(model, options);
     let err = |e: String| invalid(format!("clip '{name}': {e}"));
-    let joints = sim.simulated_joints();
+    let joints = sim.simulated_joints().to_vec();
     // Checked before anything is played or allocated: keys = frames × bones.
     let frames = (duration * options.fps).ceil() as usize + 1;
     if frames.saturating_mul(joints.len().max(1)) > MAX_BAKE_KEYS {

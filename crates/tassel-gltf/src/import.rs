@@ -44,6 +44,18 @@ pub struct Model {
     pub source: crate::ExportSource,
 }
 
+impl Model {
+    /// The animation called `name`, if the file has one.
+    pub fn clip(&self, name: &str) -> Option<&Clip> {
+        self.clips.iter().find(|c| c.name == name)
+    }
+
+    /// The index of the joint of the node called `name`.
+    pub fn joint(&self, name: &str) -> Option<usize> {
+        self.skeleton.find(name)
+    }
+}
+
 /// Loads a `.gltf`, `.glb` or `.vrm` file.
 ///
 /// A file larger than [`MAX_FILE_BYTES`] is refused before it is read.

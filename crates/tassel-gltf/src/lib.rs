@@ -9,6 +9,9 @@
 //! - [`bake_clip`]: play a clip through a [`tassel::CharacterSim`] and key the bones it
 //!   simulates.
 
+/// The core crate, re-exported (and with it `tassel::glam`).
+pub use tassel;
+
 mod accessor;
 mod bake;
 mod error;

@@ -93,7 +93,7 @@ impl Figure {
             }
         }
         let chains = sim.chains();
-        let out = sim.state().output_positions();
+        let out = sim.chain_state().output_positions();
         for p in 0..chains.point_count() {
             let info = chains.point(p);
             if let (None, Some(parent)) = (info.joint, info.parent) {
@@ -125,7 +125,7 @@ impl Figure {
             })
             .collect();
         if chains.point_count() > 0 {
-            for c in sim.state().placed_colliders() {
+            for c in sim.chain_state().placed_colliders() {
                 let placed = PlacedCollider {
                     shape: c.shape,
                     transform: *component * c.transform,

@@ -1,5 +1,7 @@
-//! One character's secondary-motion frame, wiring skeleton, chain rig and state together.
+//! One character's secondary-motion frame: a shared compiled rig and this character's
+//! states.
 
+use crate::character_rig::CharacterRig;
 use crate::controller::Level;
 use crate::dynamics::chain::{ChainJob, ChainRig, ChainState};
 use crate::dynamics::cloth::{ClothJob, ClothRig, ClothState};
@@ -11,120 +13,85 @@ use crate::error::{Error, Result};
 use crate::math::Transform;
 use crate::pose::{LocalToModelJob, Pose};
 use crate::skeleton::Skeleton;
+use glam::Vec3;
 use std::sync::Arc;
 
-/// A character ready to simulate: its skeleton, compiled rig, state and last pose.
+/// A character ready to simulate: a shared compiled [`CharacterRig`], this character's
+/// solver states and its last pose.
 ///
 /// ```
 /// use tassel::{builtin, CharacterSim, Transform};
 /// let c = builtin::character();
 /// let mut sim = CharacterSim::new(c.skeleton.clone(), &c.rig).unwrap();
 /// let rest = c.skeleton.rest().to_vec();
-/// let pose = sim.frame(&rest, Transform::IDENTITY, 1.0 / 60.0).unwrap();
+/// // The first frame takes dt = 0: it places every solver on the animated pose.
+/// let pose = sim.frame(&rest, Transform::IDENTITY, 0.0).unwrap();
 /// assert_eq!(pose.locals.len(), c.skeleton.len());
+/// let pose = sim.frame(&rest, Transform::IDENTITY, 1.0 / 60.0).unwrap();
+/// assert!(pose.models.iter().all(|m| m.is_finite()));
 /// ```
+///
+/// **The first frame.** A character starts from its animated pose: the first
+/// [`frame`](Self::frame) after [`new`](Self::new), [`from_rig`](Self::from_rig) or
+/// [`reset`](Self::reset) places every solver on the pose and moves nothing, whatever its
+/// `dt`. By convention callers pass `dt = 0` there (the CLI, the bake and the Bevy plugin
+/// do), and the frame time since the previous frame afterwards.
 #[derive(Debug, Clone)]
 pub struct CharacterSim {
-    skeleton: Skeleton,
-    rig: ChainRig,
+    rig: Arc<CharacterRig>,
     state: ChainState,
-    springs: SpringRig,
     spring_state: SpringState,
-    cloths: ClothRig,
     cloth_state: ClothState,
     ropes: Ropes,
-    vrm: VrmRig,
     vrm_state: VrmState,
     pose: Pose,
     animated_models: Vec<Transform>,
+    component: Transform,
     level: Option<Arc<Level>>,
 }
 
 impl CharacterSim {
-    /// Compiles `rig` for `skeleton`.
+    /// Compiles `rig` for `skeleton` (see [`CharacterRig::new`]); to share one compiled rig
+    /// between characters, use [`from_rig`](Self::from_rig).
     pub fn new(skeleton: Skeleton, rig: &RigSettings) -> Result<Self> {
-        Self::with_vrm(
-            skeleton,
-            rig,
-            &VrmSpringBones::default(),
-            VrmOptions::default(),
-        )
+        Ok(Self::from_rig(Arc::new(CharacterRig::new(skeleton, rig)?)))
     }
 
-    /// Compiles `rig` and a model's VRM spring bones for `skeleton`. The VRM springs run
-    /// first (on the animated pose), then chains, springs, cloths and ropes; a bone may
-    /// belong to one solver only.
+    /// Compiles `rig` and a model's VRM spring bones for `skeleton` (see
+    /// [`CharacterRig::with_vrm`]).
     pub fn with_vrm(
         skeleton: Skeleton,
         rig: &RigSettings,
         vrm: &VrmSpringBones,
         options: VrmOptions,
     ) -> Result<Self> {
-        let vrm = VrmRig::new(&skeleton, vrm, options)?;
-        let vrm_state = VrmState::new(&vrm);
-        let chains = ChainRig::new(&skeleton, rig)?;
-        let state = ChainState::new(&chains);
-        let springs = SpringRig::new(&skeleton, &rig.springs)?;
-        let spring_state = SpringState::new(&springs);
-        let cloths = ClothRig::new(&skeleton, rig)?;
-        let cloth_state = ClothState::new(&cloths);
-        rig.validate_for(&skeleton)?;
-        let ropes = Ropes::new(&skeleton, rig)?;
-        // One solver per bone, checked in one pass over an owner table (a rig may list
-        // thousands of bones). A chain owns the joints it moves and the joints it turns
-        // (its roots included); several chains may share a root, several cloths a bone.
-        let mut owner: Vec<Option<&'static str>> = vec![None; skeleton.len()];
-        let mut claim = |j: usize, who: &'static str| -> Result<()> {
-            match owner[j] {
-                Some(other) if other != who => Err(Error::InvalidParameter(format!(
-                    "bone '{}' is simulated by a {other} and by a {who}; a bone belongs \
-                     to one solver",
-                    skeleton.name(j)
-                ))),
-                _ => {
-                    owner[j] = Some(who);
-                    Ok(())
-                }
-            }
-        };
-        for j in vrm.simulated_joints() {
-            claim(j, "VRM spring")?;
-        }
-        for p in 0..chains.point_count() {
-            let info = chains.point(p);
-            if let (Some(j), Some(_)) = (info.joint, info.parent) {
-                claim(j, "chain")?;
-            }
-        }
-        for (j, _, _) in chains.rotating_joints() {
-            claim(j, "chain")?;
-        }
-        for i in 0..springs.len() {
-            claim(springs.joint(i), "spring")?;
-        }
-        for j in cloths.simulated_joints() {
-            claim(j, "cloth")?;
-        }
-        for j in ropes.simulated_joints() {
-            claim(j, "rope")?;
-        }
-        let pose = Pose::rest(&skeleton);
+        Ok(Self::from_rig(Arc::new(CharacterRig::with_vrm(
+            skeleton, rig, vrm, options,
+        )?)))
+    }
+
+    /// A new character of a compiled kind: fresh solver states, the rest pose. Cheap: the
+    /// rig is shared, only the states are allocated.
+    pub fn from_rig(rig: Arc<CharacterRig>) -> Self {
+        let pose = Pose::rest(&rig.skeleton);
         let animated_models = pose.models.clone();
-        Ok(Self {
-            skeleton,
-            rig: chains,
-            state,
-            springs,
-            spring_state,
-            cloths,
-            cloth_state,
-            ropes,
-            vrm,
-            vrm_state,
+        Self {
+            state: ChainState::new(&rig.chains),
+            spring_state: SpringState::new(&rig.springs),
+            cloth_state: ClothState::new(&rig.cloths),
+            ropes: rig.ropes.clone(),
+            vrm_state: VrmState::new(&rig.vrm),
             pose,
             animated_models,
+            component: Transform::IDENTITY,
             level: None,
-        })
+            rig,
+        }
+    }
+
+    /// The shared compiled rig.
+    pub fn rig(&self) -> &Arc<CharacterRig> {
+        &self.rig
     }
 
     /// Runs one frame: `animated` local pose, the character's world transform, frame time.
@@ -135,10 +102,10 @@ impl CharacterSim {
         component: Transform,
         dt: f32,
     ) -> Result<&Pose> {
-        if animated.len() != self.skeleton.len() {
+        if animated.len() != self.rig.skeleton.len() {
             return Err(Error::LengthMismatch {
                 what: "animated pose",
-                expected: self.skeleton.len(),
+                expected: self.rig.skeleton.len(),
                 got: animated.len(),
             });
         }
@@ -148,7 +115,7 @@ impl CharacterSim {
             return Err(Error::NonFinite(format!(
                 "animated pose of joint '{}' is not finite, not a unit rotation, or lies \
                  beyond {:e}",
-                self.skeleton.name(j),
+                self.rig.skeleton.name(j),
                 crate::limits::MAX_COORDINATE
             )));
         }
@@ -161,19 +128,20 @@ impl CharacterSim {
         if !(dt.is_finite() && dt >= 0.0) {
             return Err(Error::InvalidTimeStep(dt));
         }
+        self.component = component;
         self.pose.locals.copy_from_slice(animated);
         LocalToModelJob {
-            skeleton: &self.skeleton,
+            skeleton: &self.rig.skeleton,
             root: Transform::IDENTITY,
             locals: &self.pose.locals,
             models: &mut self.pose.models,
         }
         .run()?;
         self.animated_models.copy_from_slice(&self.pose.models);
-        if !self.vrm.is_empty() {
+        if !self.rig.vrm.is_empty() {
             VrmJob {
-                skeleton: &self.skeleton,
-                rig: &self.vrm,
+                skeleton: &self.rig.skeleton,
+                rig: &self.rig.vrm,
                 state: &mut self.vrm_state,
                 component,
                 dt,
@@ -183,8 +151,8 @@ impl CharacterSim {
             .run()?;
         }
         ChainJob {
-            skeleton: &self.skeleton,
-            rig: &self.rig,
+            skeleton: &self.rig.skeleton,
+            rig: &self.rig.chains,
             state: &mut self.state,
             component,
             dt,
@@ -193,10 +161,10 @@ impl CharacterSim {
             level: self.level.as_deref(),
         }
         .run()?;
-        if !self.springs.is_empty() {
+        if !self.rig.springs.is_empty() {
             SpringJob {
-                skeleton: &self.skeleton,
-                rig: &self.springs,
+                skeleton: &self.rig.skeleton,
+                rig: &self.rig.springs,
                 state: &mut self.spring_state,
                 component,
                 dt,
@@ -205,10 +173,10 @@ impl CharacterSim {
             }
             .run()?;
         }
-        if !self.cloths.is_empty() {
+        if !self.rig.cloths.is_empty() {
             ClothJob {
-                skeleton: &self.skeleton,
-                rig: &self.cloths,
+                skeleton: &self.rig.skeleton,
+                rig: &self.rig.cloths,
                 state: &mut self.cloth_state,
                 component,
                 dt,
@@ -219,7 +187,7 @@ impl CharacterSim {
             .run()?;
         }
         self.ropes.frame(
-            &self.skeleton,
+            &self.rig.skeleton,
             &component,
             dt,
             &mut self.pose.locals,
@@ -242,22 +210,28 @@ impl CharacterSim {
 
     /// The skeleton.
     pub fn skeleton(&self) -> &Skeleton {
-        &self.skeleton
+        &self.rig.skeleton
     }
 
     /// The compiled chains.
     pub fn chains(&self) -> &ChainRig {
-        &self.rig
+        &self.rig.chains
     }
 
     /// The chain state (output positions, placed colliders...).
+    pub fn chain_state(&self) -> &ChainState {
+        &self.state
+    }
+
+    /// The chain state (the old name of [`chain_state`](Self::chain_state)).
+    #[deprecated(note = "use chain_state(), named like spring_state(), cloth_state(), vrm_state()")]
     pub fn state(&self) -> &ChainState {
         &self.state
     }
 
     /// The compiled springs.
     pub fn springs(&self) -> &SpringRig {
-        &self.springs
+        &self.rig.springs
     }
 
     /// The spring state.
@@ -267,7 +241,7 @@ impl CharacterSim {
 
     /// The compiled cloths.
     pub fn cloths(&self) -> &ClothRig {
-        &self.cloths
+        &self.rig.cloths
     }
 
     /// The cloth state (output positions, placed colliders...).
@@ -282,7 +256,7 @@ impl CharacterSim {
 
     /// The compiled VRM spring bones.
     pub fn vrm(&self) -> &VrmRig {
-        &self.vrm
+        &self.rig.vrm
     }
 
     /// The VRM spring-bone state.
@@ -290,21 +264,53 @@ impl CharacterSim {
         &self.vrm_state
     }
 
-    /// Every joint a solver writes (VRM springs, chain joints that turn or move, springs,
-    /// cloth and rope bones), sorted, each once: the joints a bake must key.
-    pub fn simulated_joints(&self) -> Vec<usize> {
-        let mut out: Vec<usize> = self.vrm.simulated_joints().collect();
-        out.extend(self.rig.rotating_joints().map(|(j, _, _)| j));
-        out.extend((0..self.rig.point_count()).filter_map(|p| {
-            let info = self.rig.point(p);
-            info.parent.and(info.joint)
-        }));
-        out.extend((0..self.springs.len()).map(|i| self.springs.joint(i)));
-        out.extend(self.cloths.simulated_joints());
-        out.extend(self.ropes.simulated_joints());
-        out.sort_unstable();
-        out.dedup();
-        out
+    /// Every joint a solver writes, ascending, each once (see
+    /// [`CharacterRig::simulated_joints`]; no allocation).
+    pub fn simulated_joints(&self) -> &[usize] {
+        self.rig.simulated_joints()
+    }
+
+    /// The joint called `name`, if the skeleton has one.
+    pub fn bone(&self, name: &str) -> Option<usize> {
+        self.rig.skeleton.find(name)
+    }
+
+    /// The character's transform as of the last frame (identity before the first).
+    pub fn component(&self) -> Transform {
+        self.component
+    }
+
+    /// Joint `joint`'s last output transform in world space (the character's transform
+    /// times its model transform); `None` past the last joint.
+    pub fn bone_world(&self, joint: usize) -> Option<Transform> {
+        Some(self.component * *self.pose.models.get(joint)?)
+    }
+
+    /// The last output world transform of the bone called `name`.
+    pub fn bone_world_by_name(&self, name: &str) -> Option<Transform> {
+        self.bone_world(self.bone(name)?)
+    }
+
+    /// The simulated tip of chain `name` (its last point, a bone or the virtual tip) in
+    /// world space, as of the last frame.
+    pub fn chain_tip_world(&self, name: &str) -> Option<Vec3> {
+        let chain = self.rig.chain_index(name)?;
+        let last = self.rig.chains.chain_points(chain).end.checked_sub(1)?;
+        let p = *self.state.output_positions().get(last)?;
+        Some(self.component.transform_point(p))
+    }
+
+    /// The current tail of the VRM spring link on joint `joint` in world space (where the
+    /// spring's bone points), as of the last frame; `None` when no VRM spring moves it.
+    pub fn vrm_tail_world(&self, joint: usize) -> Option<Vec3> {
+        let link = self
+            .rig
+            .vrm
+            .links
+            .binary_search_by_key(&joint, |l| l.joint)
+            .ok()?;
+        self.vrm_state
+            .tail_world(&self.rig.vrm, link, &self.component, &self.pose.models)
     }
 
     /// The last output pose.

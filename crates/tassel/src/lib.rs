@@ -4,6 +4,8 @@
 //! pose, frame-rate independent, collision-aware and deterministic.
 //!
 //! Entry points:
+//! - [`CharacterSim`]: one character's frame; [`CharacterRig`]: a compiled kind of
+//!   character, shared by many (`Arc`).
 //! - [`Skeleton`], [`SkeletonBuilder`], [`Pose`], [`LocalToModelJob`], [`ModelToLocalJob`]:
 //!   the character.
 //! - [`anim::Clip`]: animation clips sampled by the glTF rules.
@@ -16,6 +18,7 @@
 
 pub mod anim;
 pub mod builtin;
+mod character_rig;
 pub mod collide;
 pub mod controller;
 pub mod crowd;
@@ -28,7 +31,11 @@ mod pose;
 pub mod rng;
 mod skeleton;
 
+pub use character_rig::CharacterRig;
 pub use error::{Error, Result};
+/// The math library Tassel's API speaks (glam 0.32), re-exported so a user needs no
+/// second, possibly different, version.
+pub use glam;
 pub use instance::CharacterSim;
 pub use math::Transform;
 pub use pose::{LocalToModelJob, ModelToLocalJob, Pose};

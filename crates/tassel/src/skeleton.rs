@@ -121,9 +121,14 @@ impl Skeleton {
         &self.names
     }
 
-    /// Name of joint `i`.
+    /// Name of joint `i` (panics past the last joint; see [`get_name`](Self::get_name)).
     pub fn name(&self, i: usize) -> &str {
         &self.names[i]
+    }
+
+    /// Name of joint `i`, or `None` past the last joint.
+    pub fn get_name(&self, i: usize) -> Option<&str> {
+        self.names.get(i).map(String::as_str)
     }
 
     /// The index of the joint called `name`.

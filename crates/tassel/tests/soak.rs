@@ -201,7 +201,7 @@ fn builtin_with(keep: &str, mode: TimeMode) -> (CharacterSim, Vec<usize>) {
         _ => unreachable!(),
     }
     let sim = CharacterSim::new(c.skeleton.clone(), &rig).unwrap();
-    let simulated = sim.simulated_joints();
+    let simulated = sim.simulated_joints().to_vec();
     assert!(!simulated.is_empty(), "{keep}: nothing simulated");
     (sim, simulated)
 }
@@ -287,7 +287,7 @@ fn degenerate_vrm(mode: VrmMode) -> (CharacterSim, Vec<usize>) {
         ..VrmOptions::default()
     };
     let sim = CharacterSim::with_vrm(sk, &RigSettings::default(), &bones, options).unwrap();
-    let simulated = sim.simulated_joints();
+    let simulated = sim.simulated_joints().to_vec();
     (sim, simulated)
 }
 
@@ -317,7 +317,7 @@ limit_angle = 60.0
     let mut rig = RigSettings::from_toml_str(text).unwrap();
     rig.chains[0].mode = mode;
     let sim = CharacterSim::new(sk, &rig).unwrap();
-    let simulated = sim.simulated_joints();
+    let simulated = sim.simulated_joints().to_vec();
     (sim, simulated)
 }
 

@@ -230,6 +230,14 @@ impl Ropes {
         self.ropes.iter().flat_map(|r| r.bones[1..].iter().copied())
     }
 
+    /// The joints the ropes turn: every bone of a rope but the last (the first one, pinned
+    /// to its animated place, included).
+    pub fn turned_joints(&self) -> impl Iterator<Item = usize> + '_ {
+        self.ropes
+            .iter()
+            .flat_map(|r| r.bones[..r.bones.len().saturating_sub(1)].iter().copied())
+    }
+
     /// Rope `i`'s particle world (world-space positions after the last step, one particle
     /// per bone).
     pub fn world(&self, i: usize) -> &ParticleWorld {

@@ -236,9 +236,20 @@ impl ChainRig {
         &self.chains[i].settings
     }
 
-    /// The point range of chain `i`.
+    /// The point range of chain `i` (panics past the last chain; see
+    /// [`get_chain_points`](Self::get_chain_points)).
     pub fn chain_points(&self, i: usize) -> Range<usize> {
         self.chains[i].points.clone()
+    }
+
+    /// The point range of chain `i`, or `None` past the last chain.
+    pub fn get_chain_points(&self, i: usize) -> Option<Range<usize>> {
+        self.chains.get(i).map(|c| c.points.clone())
+    }
+
+    /// What point `p` is, or `None` past the last point.
+    pub fn get_point(&self, p: usize) -> Option<PointInfo> {
+        (p < self.joint.len()).then(|| self.point(p))
     }
 
     /// What point `p` is.

@@ -319,6 +319,19 @@ impl ClothRig {
             .filter_map(|(j, f)| if *f { None } else { *j })
     }
 
+    /// The joints a cloth turns toward its simulated points: every bone followed in its
+    /// chain by a free point, pinned bones (the first row) included. A superset of
+    /// [`simulated_joints`](Self::simulated_joints) by those pinned bones.
+    pub fn turned_joints(&self) -> impl Iterator<Item = usize> + '_ {
+        self.cloths.iter().flat_map(move |cloth| {
+            cloth.chains.iter().flat_map(move |ch| {
+                (ch.start..ch.end.saturating_sub(1))
+                    .filter(move |&p| !self.fixed[p + 1])
+                    .filter_map(move |p| self.joint[p])
+            })
+        })
+    }
+
     /// Point ranges of cloth `i`'s chains, in order.
     pub fn chains(&self, i: usize) -> &[Range<usize>] {
         &self.cloths[i].chains

@@ -73,8 +73,26 @@ impl VrmState {
         self.reset();
     }
 
+    /// Link `link`'s current tail in world space, given the character transform and the
+    /// model pose the tails were last computed with; `None` past the last link.
+    pub fn tail_world(
+        &self,
+        rig: &VrmRig,
+        link: usize,
+        component: &Transform,
+        models: &[Transform],
+    ) -> Option<Vec3> {
+        let l = rig.links.get(link)?;
+        let t = *self.current_tail.get(link)?;
+        Some(match l.center {
+            Some(c) => (*component * *models.get(c)?).transform_point(t),
+            None => t,
+        })
+    }
+
     /// Each link's current tail in world space, given the character transform and the
-    /// model pose the tails were last computed with.
+    /// model pose the tails were last computed with (allocates; see
+    /// [`VrmState::tail_world`] for one link).
     pub fn tails_world(
         &self,
         rig: &VrmRig,
