@@ -93,10 +93,11 @@ impl CharacterRig {
         for i in 0..springs.len() {
             claim(springs.joint(i), "spring")?;
         }
-        for j in cloths.simulated_joints() {
+        // A cloth and a rope also turn their pinned first bones.
+        for j in cloths.simulated_joints().chain(cloths.turned_joints()) {
             claim(j, "cloth")?;
         }
-        for j in ropes.simulated_joints() {
+        for j in ropes.simulated_joints().chain(ropes.turned_joints()) {
             claim(j, "rope")?;
         }
         let mut simulated: Vec<usize> = (0..skeleton.len())
@@ -140,7 +141,7 @@ impl CharacterRig {
     }
 
     /// Every joint a solver writes (VRM springs, chain joints that turn or move, springs,
-    /// cloth and rope bones), ascending, each once: the joints a bake must key and an
+    /// cloth and rope bones, the pinned first bones cloths and ropes turn), ascending, each once: the joints a bake must key and an
     /// engine must copy back. Computed once, at compile time.
     pub fn simulated_joints(&self) -> &[usize] {
         &self.simulated

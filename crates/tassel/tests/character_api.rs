@@ -57,6 +57,17 @@ fn simulated_joints_are_each_solvers_bones_once_ascending() {
     want.extend((0..sim.springs().len()).map(|i| sim.springs().joint(i)));
     want.extend(sim.cloths().simulated_joints());
     want.extend(sim.ropes().simulated_joints());
+    // The pinned first bones a cloth or a rope turns toward its first free point.
+    let sk = sim.skeleton();
+    for j in sim
+        .cloths()
+        .simulated_joints()
+        .chain(sim.ropes().simulated_joints())
+    {
+        if let Some(p) = sk.parent(j) {
+            want.push(p);
+        }
+    }
     want.sort_unstable();
     want.dedup();
     assert_eq!(joints, &want[..]);
@@ -173,6 +184,31 @@ fn output_models_are_the_output_locals_composed() {
         worst.2,
         worst.0
     );
+}
+
+#[test]
+fn only_the_simulated_joints_change() {
+    // What an engine copies back (`simulated_joints`) is every joint whose local the
+    // solvers changed.
+    let c = builtin::character();
+    let mut sim = CharacterSim::new(c.skeleton.clone(), &c.rig).unwrap();
+    let mut locals = c.skeleton.rest().to_vec();
+    let mut changed = vec![false; c.skeleton.len()];
+    for k in 0..240 {
+        let t = k as f32 / 60.0;
+        locals.copy_from_slice(c.skeleton.rest());
+        c.clips[builtin::clip::WALK].sample_looped(t, &mut locals);
+        sim.frame(&locals, walk(t), if k == 0 { 0.0 } else { 1.0 / 60.0 })
+            .unwrap();
+        for (j, l) in sim.pose().locals.iter().enumerate() {
+            changed[j] |= *l != locals[j];
+        }
+    }
+    let changed: Vec<&str> = (0..changed.len())
+        .filter(|&j| changed[j] && !sim.simulated_joints().contains(&j))
+        .map(|j| c.skeleton.name(j))
+        .collect();
+    assert!(changed.is_empty(), "changed but not listed: {changed:?}");
 }
 
 #[test]
