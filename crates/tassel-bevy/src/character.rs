@@ -1,0 +1,128 @@
+//! The components a user touches: [`SecondaryMotion`] (what to simulate) and
+//! [`TasselCharacter`] (the running simulation, added by the plugin).
+
+use crate::assets::{TasselModel, TasselRig};
+use bevy::asset::Handle;
+use bevy::ecs::component::Component;
+use bevy::ecs::entity::Entity;
+use tassel::dynamics::SimMode;
+use tassel::CharacterSim;
+
+/// Secondary motion for the hierarchy under this entity: put it on the entity that holds
+/// a glTF/VRM scene (`WorldAssetRoot`, formerly `SceneRoot`) or on the root of any
+/// hierarchy of named entities. Once the model (and rig) have loaded and the bones are
+/// spawned, the plugin finds each bone by name below this entity, compiles the character
+/// (shared with every character of the same model, rig and mode) and adds a
+/// [`TasselCharacter`]; from then on it reads the animated bone `Transform`s each frame,
+/// steps, and writes the simulated bones back before transform propagation.
+///
+/// Changing any field starts the character again (new rig, new mode).
+#[derive(Component, Debug, Clone)]
+pub struct SecondaryMotion {
+    /// The model: its skeleton and, in a VRM, its spring bones.
+    pub model: Handle<TasselModel>,
+    /// An optional rig file (`.rig.toml`): chains, springs, cloths, ropes.
+    pub rig: Option<Handle<TasselRig>>,
+    /// How to step. [`SimMode::Fixed`] (the default) looks the same at every frame rate;
+    /// [`SimMode::Spec`] steps VRM springs once per frame as the VRM specification does.
+    pub mode: SimMode,
+    /// Run the file's VRM spring bones (default `true`).
+    pub vrm_springs: bool,
+}
+
+impl SecondaryMotion {
+    /// The model's own VRM spring bones, fixed-rate stepping.
+    pub fn new(model: Handle<TasselModel>) -> Self {
+        Self {
+            model,
+            rig: None,
+            mode: SimMode::Fixed,
+            vrm_springs: true,
+        }
+    }
+
+    /// Adds a rig file's chains, springs, cloths and ropes.
+    pub fn with_rig(mut self, rig: Handle<TasselRig>) -> Self {
+        self.rig = Some(rig);
+        self
+    }
+
+    /// Sets the stepping mode.
+    pub fn with_mode(mut self, mode: SimMode) -> Self {
+        self.mode = mode;
+        self
+    }
+
+    /// Leaves the file's VRM spring bones out (e.g. to run only a rig's chains).
+    pub fn without_vrm_springs(mut self) -> Self {
+        self.vrm_springs = false;
+        self
+    }
+}
+
+/// The running simulation of a [`SecondaryMotion`] entity, added by the plugin once the
+/// bones are found. Read results through [`sim`](Self::sim) (world space: bone
+/// transforms, chain tips, VRM tails); [`reset`](Self::reset) and
+/// [`teleport`](Self::teleport) restart the motion from the animated pose.
+#[derive(Component, Debug)]
+pub struct TasselCharacter {
+    pub(crate) sim: CharacterSim,
+    /// Joint → the entity that stands for it (`None`: not found, rest pose used).
+    pub(crate) bones: Vec<Option<Entity>>,
+    /// The simulated joints that have an entity: written back each frame.
+    pub(crate) written: Vec<(usize, Entity)>,
+    /// The entity whose world transform is the skeleton's model space (the parent of the
+    /// root bone's entity).
+    pub(crate) space: Option<Entity>,
+    /// The next frame is the first: dt = 0 places every solver on the pose.
+    pub(crate) first_frame: bool,
+    /// The last frame's error, reported once until it changes.
+    pub(crate) last_error: Option<String>,
+    /// The animated local pose as last seen (what the solvers start from).
+    pub(crate) locals: Vec<tassel::Transform>,
+    /// What the plugin wrote into each of `written` last frame: a bone still holding it
+    /// was not animated since, and keeps its last animated pose as input (no feedback of
+    /// the simulated pose into the next frame's input).
+    pub(crate) wrote: Vec<Option<tassel::Transform>>,
+}
+
+impl TasselCharacter {
+    /// The simulation: its pose, states and world-space results as of the last frame.
+    pub fn sim(&self) -> &CharacterSim {
+        &self.sim
+    }
+
+    /// The entity that stands for the bone called `name`, if it was found.
+    pub fn bone_entity(&self, name: &str) -> Option<Entity> {
+        self.bones.get(self.sim.bone(name)?).copied().flatten()
+    }
+
+    /// The entity whose world transform is the skeleton's model space (the parent of the
+    /// root bone's entity; `None`: the root bone's entity has no parent, the world).
+    pub fn space(&self) -> Option<Entity> {
+        self.space
+    }
+
+    /// Starts every solver again from the animated pose on the next frame.
+    pub fn reset(&mut self) {
+        self.first_frame = true;
+    }
+
+    /// The character was moved on purpose (respawn, cut): start again from the pose at
+    /// the new place instead of whipping the hair across the level.
+    pub fn teleport(&mut self) {
+        self.reset();
+    }
+
+    /// The last frame's error, if the last frame failed (e.g. a NaN in a bone's
+    /// `Transform`); the bones keep their animated pose while it lasts.
+    pub fn error(&self) -> Option<&str> {
+        self.last_error.as_deref()
+    }
+}
+
+/// Added instead of [`TasselCharacter`] when a character cannot run (a bone not found, a
+/// rig that does not fit the skeleton, an asset that failed to load); the message says
+/// why. Changing the [`SecondaryMotion`] tries again.
+#[derive(Component, Debug, Clone, PartialEq, Eq)]
+pub struct TasselFailed(pub String);
