@@ -112,6 +112,19 @@ pub enum TasselAssetError {
     },
 }
 
+/// Every byte of an asset, or an error naming its path.
+async fn read_all(reader: &mut dyn Reader, path: &str) -> Result<Vec<u8>, TasselAssetError> {
+    let mut bytes = Vec::new();
+    reader
+        .read_to_end(&mut bytes)
+        .await
+        .map_err(|source| TasselAssetError::Io {
+            path: path.to_string(),
+            source,
+        })?;
+    Ok(bytes)
+}
+
 /// Loads [`TasselModel`] from `.gltf` (with its buffers embedded), `.glb` and `.vrm` files.
 #[derive(Default, TypePath)]
 pub struct TasselModelLoader;
@@ -128,14 +141,7 @@ impl AssetLoader for TasselModelLoader {
         load_context: &mut LoadContext<'_>,
     ) -> Result<TasselModel, TasselAssetError> {
         let path = load_context.path().to_string();
-        let mut bytes = Vec::new();
-        reader
-            .read_to_end(&mut bytes)
-            .await
-            .map_err(|source| TasselAssetError::Io {
-                path: path.clone(),
-                source,
-            })?;
+        let mut bytes = read_all(reader, &path).await?;
         if !bytes.starts_with(b"glTF") {
             bytes = inline_buffers(bytes, load_context).await?;
         }
@@ -219,14 +225,7 @@ impl AssetLoader for TasselRigLoader {
         load_context: &mut LoadContext<'_>,
     ) -> Result<TasselRig, TasselAssetError> {
         let path = load_context.path().to_string();
-        let mut bytes = Vec::new();
-        reader
-            .read_to_end(&mut bytes)
-            .await
-            .map_err(|source| TasselAssetError::Io {
-                path: path.clone(),
-                source,
-            })?;
+        let bytes = read_all(reader, &path).await?;
         let text = std::str::from_utf8(&bytes).map_err(|e| TasselAssetError::Rig {
             path: path.clone(),
             message: format!("not UTF-8: {e}"),

@@ -28,14 +28,7 @@ fn builtin_scene(hz: f64, mode: SimMode) -> Scene {
 fn builtin_scene_with(hz: f64, mode: SimMode, animate: bool) -> Scene {
     let c = builtin::character();
     let mut app = app(hz);
-    let model = app
-        .world_mut()
-        .resource_mut::<Assets<TasselModel>>()
-        .add(TasselModel::new(c.skeleton.clone(), None));
-    let rig = app
-        .world_mut()
-        .resource_mut::<Assets<TasselRig>>()
-        .add(TasselRig(c.rig.clone()));
+    let (model, rig) = builtin_assets(&mut app, &c);
     let character = app
         .world_mut()
         .spawn((
@@ -59,6 +52,22 @@ fn builtin_scene_with(hz: f64, mode: SimMode, animate: bool) -> Scene {
         bones,
         skeleton: c.skeleton,
     }
+}
+
+/// The built-in character's skeleton and rig added as assets.
+fn builtin_assets(
+    app: &mut App,
+    c: &builtin::Character,
+) -> (Handle<TasselModel>, Handle<TasselRig>) {
+    let model = app
+        .world_mut()
+        .resource_mut::<Assets<TasselModel>>()
+        .add(TasselModel::new(c.skeleton.clone(), None));
+    let rig = app
+        .world_mut()
+        .resource_mut::<Assets<TasselRig>>()
+        .add(TasselRig(c.rig.clone()));
+    (model, rig)
 }
 
 /// The reference: a `CharacterSim` of the built-in character in `mode`, compiled here as
@@ -357,14 +366,7 @@ fn a_nan_bone_skips_the_frame_and_the_next_good_frame_carries_on() {
 fn a_missing_bone_is_an_error_naming_it() {
     let c = builtin::character();
     let mut app = app(60.0);
-    let model = app
-        .world_mut()
-        .resource_mut::<Assets<TasselModel>>()
-        .add(TasselModel::new(c.skeleton.clone(), None));
-    let rig = app
-        .world_mut()
-        .resource_mut::<Assets<TasselRig>>()
-        .add(TasselRig(c.rig.clone()));
+    let (model, rig) = builtin_assets(&mut app, &c);
     let character = app
         .world_mut()
         .spawn((
