@@ -26,9 +26,9 @@ pub struct Args {
     /// Keys per second of the baked bones.
     #[arg(long, default_value_t = 60.0)]
     fps: f32,
-    /// spec: VRM springs by the specification (default for VRM); fixed: VRM springs and
-    /// chains at a fixed rate; classic: chains frame by frame. Default for a rig: what the
-    /// rig says.
+    /// fixed (default for VRM): VRM springs and chains at a fixed rate, the same look at
+    /// every frame rate; spec: VRM springs by the specification; classic: chains frame by
+    /// frame. Default for a rig: what the rig says.
     #[arg(long, value_enum)]
     mode: Option<Mode>,
     /// Seconds each clip plays, looped, before its first key, so that the motion starts

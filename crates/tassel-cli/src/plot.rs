@@ -106,8 +106,9 @@ pub fn run(a: Args) -> Result<(), String> {
                 let out = c.transform_point(f.sim.pose().models[joint].translation);
                 let anim = c.transform_point(f.sim.animated_models()[joint].translation);
                 points.push((f.time, (out - anim).length()));
-                Ok(())
-            })?;
+                Ok::<(), String>(())
+            })
+            .map_err(|e| e.to_string())?;
             series.push(ChartSeries {
                 name: format!("{} {} HZ", m.name(), rate),
                 color: PALETTE[(mi * a.rates.len() + ri) % PALETTE.len()],

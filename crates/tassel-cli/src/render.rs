@@ -103,8 +103,9 @@ pub fn run(a: Args) -> Result<(), String> {
         for _ in picked.iter().filter(|&&p| p == f.index) {
             figures.push(Figure::from_sim(f.sim, &f.component, f.time));
         }
-        Ok(())
-    })?;
+        Ok::<(), String>(())
+    })
+    .map_err(|e| e.to_string())?;
     let clip_name = clip.map(|c| c.name.as_str()).unwrap_or("REST");
     let title = format!("{} - {} - {}", subject.name, clip_name, mode.name());
     let bytes = if gif {

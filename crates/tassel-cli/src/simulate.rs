@@ -56,9 +56,10 @@ pub struct Args {
     /// Use the embedded character.
     #[arg(long)]
     builtin: bool,
-    /// spec: VRM springs by the specification (default for VRM); fixed: VRM springs and
-    /// chains at a fixed rate; classic: chains frame by frame (VRM springs spec).
-    /// Default for a rig: what the rig says.
+    /// fixed (default for VRM): VRM springs and chains at a fixed rate, the same look at
+    /// every frame rate; spec: VRM springs by the specification; classic: chains frame by
+    /// frame (VRM springs spec); three-vrm: as three-vrm 3.5.5. Default for a rig: what the
+    /// rig says.
     #[arg(long, value_enum)]
     mode: Option<Mode>,
     /// Number of frames.

@@ -340,9 +340,10 @@ fn simulate_vrm_follows_the_contract() {
     );
     let doc: serde_json::Value =
         serde_json::from_slice(&std::fs::read(&out_file).unwrap()).unwrap();
-    // A VRM runs in spec mode by default; the joints are the spring's joints without its
-    // last (tail-only) joint: nodes 19, 20, 21 with tails 20, 21, 22 (from the file).
-    assert_eq!(doc["mode"], "spec");
+    // A VRM runs in fixed mode by default (the one default of every stepping switch); the
+    // joints are the spring's joints without its last (tail-only) joint: nodes 19, 20, 21
+    // with tails 20, 21, 22 (from the file).
+    assert_eq!(doc["mode"], "fixed");
     let joints = doc["joints"].as_array().unwrap();
     let nodes: Vec<u64> = joints.iter().map(|j| j["node"].as_u64().unwrap()).collect();
     let tails: Vec<u64> = joints

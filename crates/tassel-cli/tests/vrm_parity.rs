@@ -276,7 +276,7 @@ fn node_constraints_match_three_vrm() {
         sk.clone(),
         &tassel::dynamics::RigSettings::default(),
         &vrm.springs,
-        tassel::dynamics::vrm::VrmOptions::default(),
+        tassel::dynamics::vrm::VrmOptions::spec(),
     )
     .unwrap();
     let axis = Vec3::new(1.0, 2.0, 3.0).normalize();

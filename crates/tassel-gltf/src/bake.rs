@@ -1,7 +1,7 @@
 //! Baking secondary motion into a model's clips: play a clip (looped through a warm-up),
 //! run the character's solvers frame by frame, and key the bones they move.
 
-use crate::error::GltfError;
+use crate::error::{GltfError, PlayError};
 use crate::export::{BakedClip, BakedTrack};
 use crate::import::Model;
 use glam::{Quat, Vec3};
@@ -171,15 +171,16 @@ pub struct PlayedFrame<'a> {
 /// looped from `-warmup` seconds; the first frame, with dt = 0, places every solver on the
 /// animated pose), then one frame at each of `times` (the clip sampled exactly there, not
 /// wrapped), calling `on_frame` after each. The character's transform is
-/// [`BakeOptions::component`]. Errors from `sim` and from `on_frame` stop the run.
-pub fn play(
+/// [`BakeOptions::component`]. Errors from `sim` and from `on_frame` stop the run; an
+/// `on_frame` error comes back as [`PlayError::Frame`], unchanged.
+pub fn play<E>(
     sim: &mut CharacterSim,
     clip: Option<&Clip>,
     times: &[f32],
     options: &BakeOptions,
-    on_frame: &mut dyn FnMut(&PlayedFrame) -> Result<(), String>,
-) -> Result<(), String> {
-    options.validate().map_err(|e| e.to_string())?;
+    on_frame: &mut dyn FnMut(&PlayedFrame) -> Result<(), E>,
+) -> Result<(), PlayError<E>> {
+    options.validate().map_err(PlayError::Options)?;
     let rest = sim.skeleton().rest().to_vec();
     let mut locals = rest.clone();
     let step = 1.0 / options.fps;
@@ -195,7 +196,7 @@ pub fn play(
         }
         let dt = if k == 0 { 0.0 } else { t - t_prev };
         sim.frame(&locals, options.component(t), dt)
-            .map_err(|e| e.to_string())?;
+            .map_err(|source| PlayError::Simulation { time: t, source })?;
         t_prev = t;
     }
     for (k, &t) in times.iter().enumerate() {
@@ -210,14 +211,15 @@ pub fn play(
         };
         let component = options.component(t);
         sim.frame(&locals, component, dt)
-            .map_err(|e| e.to_string())?;
+            .map_err(|source| PlayError::Simulation { time: t, source })?;
         on_frame(&PlayedFrame {
             index: k,
             time: t,
             animated: &locals,
             component,
             sim,
-        })?;
+        })
+        .map_err(PlayError::Frame)?;
         t_prev = t;
     }
     Ok(())
@@ -302,9 +304,9 @@ pub fn bake_clip(
             root_translations[i].push(component.translation + pose.locals[r].translation);
         }
         progress(k + 1, times.len());
-        Ok(())
+        Ok::<(), String>(())
     })
-    .map_err(err)?;
+    .map_err(|e| err(e.to_string()))?;
     let mut tracks: Vec<BakedTrack> = joints
         .iter()
         .enumerate()

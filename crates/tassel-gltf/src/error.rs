@@ -30,3 +30,23 @@ pub enum GltfError {
         source: tassel::Error,
     },
 }
+
+/// Why [`crate::play`] stopped: its options, the simulation, or the caller's `on_frame`
+/// (whose own error type `E` comes back unchanged).
+#[derive(Debug, Error)]
+pub enum PlayError<E> {
+    /// The [`crate::BakeOptions`] are invalid.
+    #[error("{0}")]
+    Options(#[source] GltfError),
+    /// The simulation refused a frame (a non-finite pose, a broken state).
+    #[error("frame at {time} s: {source}")]
+    Simulation {
+        /// Seconds into the clip (negative during the warm-up).
+        time: f32,
+        /// What the simulation said.
+        source: tassel::Error,
+    },
+    /// `on_frame` returned an error.
+    #[error("{0}")]
+    Frame(E),
+}

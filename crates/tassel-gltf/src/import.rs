@@ -369,7 +369,7 @@ pub fn load_slice(bytes: &[u8], base_dir: Option<&Path>, name: &str) -> Result<M
     let json: serde_json::Value =
         serde_json::to_value(doc.as_json()).map_err(|e| invalid(e.to_string()))?;
     let json = raw_json(bytes).unwrap_or(json);
-    let vrm = crate::vrm::read_spring_bones(&json, &node_to_joint, &mut warnings)
+    let vrm = crate::vrm::read(&json, &node_to_joint, &mut warnings)
         .map_err(|m| invalid(format!("spring bones: {m}")))?;
     if let Some(v) = &vrm {
         v.springs

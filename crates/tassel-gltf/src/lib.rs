@@ -24,7 +24,7 @@ mod vrm;
 pub use bake::{
     bake_clip, key_times, play, BakeOptions, BakeSource, PlayedFrame, Sway, MAX_BAKE_KEYS,
 };
-pub use error::GltfError;
+pub use error::{GltfError, PlayError};
 pub use export::{export_glb, BakedClip, BakedTrack, BoneMesh, ExportSource};
 pub use import::{load, load_slice, Model, SkinInfo, MAX_FILE_BYTES};
 pub use mesh::MeshInstance;

@@ -1,6 +1,7 @@
 //! Reading VRM spring bones from the glTF JSON: `VRMC_springBone` 1.0 (with
 //! `VRMC_springBone_extended_collider` 1.0) and VRM 0.x `extensions.VRM.secondaryAnimation`.
 
+use crate::GltfError;
 use glam::Vec3;
 use serde_json::Value;
 use tassel::dynamics::vrm::{
@@ -31,8 +32,21 @@ pub const VRM0_TAIL_LENGTH: f32 = 0.07;
 
 /// Reads the spring bones of `json` (a glTF document). `VRMC_springBone` wins over VRM 0.x
 /// when a file has both. `node_to_joint` maps glTF nodes to skeleton joints. Returns
-/// `Ok(None)` for a file without spring bones; an `Err` names the offending entry.
+/// `Ok(None)` for a file without spring bones; an error ([`GltfError::Invalid`], path
+/// `<json>`) names the offending entry.
 pub fn read_spring_bones(
+    json: &Value,
+    node_to_joint: &[usize],
+    warnings: &mut Vec<String>,
+) -> Result<Option<VrmInfo>, GltfError> {
+    read(json, node_to_joint, warnings).map_err(|m| GltfError::Invalid {
+        path: "<json>".into(),
+        message: format!("spring bones: {m}"),
+    })
+}
+
+/// [`read_spring_bones`] with the message alone, for the importer to place in its file.
+pub(crate) fn read(
     json: &Value,
     node_to_joint: &[usize],
     warnings: &mut Vec<String>,

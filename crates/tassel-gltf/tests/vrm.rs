@@ -268,7 +268,7 @@ fn with_no_stiffness_gravity_makes_it_hang() {
             Vec3::ZERO,
             Quat::from_rotation_z(std::f32::consts::FRAC_PI_2),
         );
-        let mut run = Run::new(model, &bones, VrmOptions::default());
+        let mut run = Run::new(model, &bones, VrmOptions::spec());
         let start: Vec<f32> = run
             .joints_and_tails(&side)
             .iter()
@@ -602,7 +602,7 @@ fn vrm0_secondary_animation() {
     }
     // It runs: lengths kept, no NaN.
     let bones = b.clone();
-    let mut run = Run::new(model, &bones, VrmOptions::default());
+    let mut run = Run::new(model, &bones, VrmOptions::spec());
     run.frame(Transform::IDENTITY, 0.0);
     let l0: Vec<f32> = run
         .joints_and_tails(&Transform::IDENTITY)

@@ -20,7 +20,7 @@ fn at(f: u32, i: usize) -> Transform {
 
 fn vrm_crowd(c: &mut Criterion) {
     let (sk, bones) = builtin::bench_vrm(16, 8, 8);
-    let options = VrmOptions::default();
+    let options = VrmOptions::spec();
     let rig = Arc::new(VrmRig::new(&sk, &bones, options).unwrap());
     let rest = sk.rest().to_vec();
     let joints = (N * rig.links.len()) as u64;

@@ -15,6 +15,19 @@
 //! - [`builtin`]: an embedded demo character with procedural clips.
 //!
 //! The core does no file I/O.
+//!
+//! ## Units and conventions
+//! - Lengths in metres, times in seconds, Y up, right-handed (glTF's frame).
+//! - **Angles in degrees** wherever a person types or reads one: rig files and every
+//!   settings struct (`limit_angle`, `teleport_angle`, `teleport_rotation`, the
+//!   controller's `max_climb_angle` and `min_slide_angle`), [`controller::Movement::slope_angle`],
+//!   [`controller::LevelShape::ramp_with_angle`] and particle angle constraints. Rotations
+//!   themselves are glam `Quat`s.
+//! - **Stepping**: [`dynamics::SimMode`] is the one switch for a character; its default is
+//!   `Fixed` (frame-rate independent), like [`dynamics::chain::TimeMode`] and
+//!   [`dynamics::vrm::VrmMode`]. `Spec` and `ThreeVrm` stay available by name for parity
+//!   with the VRM specification and three-vrm.
+//! - The first frame of a run is stepped with `dt = 0` (see [`CharacterSim`]).
 
 pub mod anim;
 pub mod builtin;

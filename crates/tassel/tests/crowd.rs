@@ -215,7 +215,7 @@ fn vrm_crowd_gives_the_single_character_bits_with_centres_planes_and_inside_shap
 #[test]
 fn vrm_crowd_is_the_same_on_one_and_two_threads() {
     let (sk, bones) = builtin::bench_vrm(8, 6, 8);
-    let rig = Arc::new(VrmRig::new(&sk, &bones, VrmOptions::default()).unwrap());
+    let rig = Arc::new(VrmRig::new(&sk, &bones, VrmOptions::spec()).unwrap());
     let sk = Arc::new(sk);
     let run = |threads: usize, avx2: bool| -> Vec<u32> {
         let pool = rayon::ThreadPoolBuilder::new()
@@ -258,7 +258,7 @@ fn vrm_crowd_is_the_same_on_one_and_two_threads() {
 #[test]
 fn vrm_crowd_rejects_bad_input_by_character() {
     let (sk, bones) = builtin::bench_vrm(4, 5, 2);
-    let rig = Arc::new(VrmRig::new(&sk, &bones, VrmOptions::default()).unwrap());
+    let rig = Arc::new(VrmRig::new(&sk, &bones, VrmOptions::spec()).unwrap());
     let sk = Arc::new(sk);
     let mut crowd = VrmCrowd::new(sk.clone(), rig.clone()).unwrap();
     for _ in 0..20 {

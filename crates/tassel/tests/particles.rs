@@ -142,7 +142,9 @@ fn angle_constraint_keeps_a_folded_joint_open() {
     w.add_stick(c, a).unwrap();
     w.add_stick(c, b).unwrap();
     w.pin(c, Vec3::ZERO).unwrap();
-    w.add_angle_constraint(a, c, b, 1.0, 2.0).unwrap();
+    // 1 and 2 radians, given in degrees.
+    w.add_angle_constraint(a, c, b, 1f32.to_degrees(), 2f32.to_degrees())
+        .unwrap();
     for _ in 0..120 {
         w.step(1.0 / 60.0).unwrap();
         let (da, db) = (w.position(a) - w.position(c), w.position(b) - w.position(c));

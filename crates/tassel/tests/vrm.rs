@@ -95,7 +95,7 @@ fn spec_mode_matches_the_equations_worked_by_hand() {
         springs: vec![spring(joint, vec![0])],
         ..Default::default()
     };
-    let mut run = Run::new(one_joint(), &bones, VrmOptions::default());
+    let mut run = Run::new(one_joint(), &bones, VrmOptions::spec());
     // The character: still in frames 0 and 1, then 0.1 m along +Z per frame.
     let root_z = |f: usize| if f < 2 { 0.0 } else { 0.1 * (f - 1) as f64 };
 
@@ -163,8 +163,8 @@ fn center_space_carries_the_tails_with_the_centre() {
         springs: vec![spring(joint, vec![])],
         ..Default::default()
     };
-    let mut moving = Run::new(one_joint(), &bones_c, VrmOptions::default());
-    let mut still = Run::new(one_joint(), &bones_w, VrmOptions::default());
+    let mut moving = Run::new(one_joint(), &bones_c, VrmOptions::spec());
+    let mut still = Run::new(one_joint(), &bones_w, VrmOptions::spec());
     moving.frame(Transform::IDENTITY, 0.0);
     still.frame(Transform::IDENTITY, 0.0);
     let mut swung = 0.0f32;
@@ -180,7 +180,7 @@ fn center_space_carries_the_tails_with_the_centre() {
     // Gravity did swing it (so equality is not trivial).
     assert!(swung > 0.3, "{swung}");
     // Without a centre the same motion does change the swing.
-    let mut world = Run::new(one_joint(), &bones_w, VrmOptions::default());
+    let mut world = Run::new(one_joint(), &bones_w, VrmOptions::spec());
     world.frame(Transform::IDENTITY, 0.0);
     let mut differs = 0.0f32;
     for f in 1..=120 {
@@ -277,7 +277,7 @@ fn bad_settings_are_named() {
         ),
     ];
     for (bones, want) in cases {
-        let e = VrmRig::new(&sk, &bones, VrmOptions::default())
+        let e = VrmRig::new(&sk, &bones, VrmOptions::spec())
             .expect_err(want)
             .to_string();
         assert!(e.contains(want), "'{e}' does not say '{want}'");
@@ -388,7 +388,7 @@ fn a_bone_belongs_to_one_solver() {
         )],
         ..Default::default()
     };
-    let e = CharacterSim::with_vrm(one_joint(), &rig, &bones, VrmOptions::default())
+    let e = CharacterSim::with_vrm(one_joint(), &rig, &bones, VrmOptions::spec())
         .expect_err("shared bone")
         .to_string();
     assert!(
@@ -400,7 +400,7 @@ fn a_bone_belongs_to_one_solver() {
         one_joint(),
         &RigSettings::default(),
         &bones,
-        VrmOptions::default(),
+        VrmOptions::spec(),
     )
     .unwrap();
     let rest = one_joint().rest().to_vec();
@@ -452,7 +452,7 @@ fn a_collider_listed_twice_acts_twice() {
         )],
         ..Default::default()
     };
-    let rig = VrmRig::new(&one_joint(), &bones, VrmOptions::default()).unwrap();
+    let rig = VrmRig::new(&one_joint(), &bones, VrmOptions::spec()).unwrap();
     let range = rig.links[0].colliders.clone();
     assert_eq!(&rig.link_colliders[range], &[0, 1, 0, 0, 1]);
 }

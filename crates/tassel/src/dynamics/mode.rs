@@ -6,14 +6,15 @@ use super::vrm::{VrmMode, VrmOptions};
 use super::RigSettings;
 use crate::error::{Error, Result};
 
-/// How a character's secondary motion is stepped.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// How a character's secondary motion is stepped. The default is [`SimMode::Fixed`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum SimMode {
     /// VRM springs exactly as the VRM specification steps them (once per frame, the look
     /// depends on the frame rate); rig chains keep the mode the rig file gives them.
     Spec,
     /// VRM springs and chains at a fixed internal rate: the look does not depend on the
-    /// frame rate.
+    /// frame rate. The default.
+    #[default]
     Fixed,
     /// Chains frame by frame as KawaiiPhysics does (VRM springs by the specification): the
     /// frame-rate-dependent pair, for comparison.
@@ -35,8 +36,9 @@ impl SimMode {
     }
 
     /// Settles the mode for a rig (and a model with or without VRM springs) and sets the
-    /// rig's chains to it. Without a requested mode: `spec` for a model with VRM springs,
-    /// else the first chain's own mode. `spec` without VRM springs is an error; `fixed` or
+    /// rig's chains to it. Without a requested mode: `fixed` for a model with VRM springs,
+    /// else the first chain's own mode (the rig file's choice; `fixed` unless it says
+    /// `classic`). `spec` without VRM springs is an error; `fixed` or
     /// `classic` asked for explicitly set every chain's mode.
     pub fn apply(
         requested: Option<SimMode>,
@@ -45,7 +47,7 @@ impl SimMode {
     ) -> Result<(SimMode, VrmOptions)> {
         let mode = match requested {
             Some(m) => m,
-            None if has_vrm => SimMode::Spec,
+            None if has_vrm => SimMode::Fixed,
             None => match rig.chains.first().map(|c| c.mode) {
                 Some(TimeMode::Classic) => SimMode::Classic,
                 _ => SimMode::Fixed,

@@ -141,9 +141,9 @@ pub struct AngleConstraint {
     pub center: usize,
     /// The other arm's end.
     pub b: usize,
-    /// Smallest angle, radians.
+    /// Smallest angle, degrees.
     pub min: f32,
-    /// Largest angle, radians.
+    /// Largest angle, degrees.
     pub max: f32,
 }
 
@@ -278,7 +278,7 @@ impl ParticleWorld {
     }
 
     /// Keeps the angle at `center` between the arms to `a` and `b` within
-    /// `[min, max]` radians (0 ≤ min ≤ max ≤ π).
+    /// `[min, max]` degrees (0 ≤ min ≤ max ≤ 180).
     pub fn add_angle_constraint(
         &mut self,
         a: usize,
@@ -290,9 +290,9 @@ impl ParticleWorld {
         for i in [a, center, b] {
             self.check(i, "angle constraint")?;
         }
-        if !(min >= 0.0 && min <= max && max <= std::f32::consts::PI) {
+        if !(min >= 0.0 && min <= max && max <= 180.0) {
             return Err(Error::InvalidParameter(format!(
-                "angle constraint at {center}: range [{min}, {max}] is not within [0, π]"
+                "angle constraint at {center}: range [{min}, {max}] ° is not within [0, 180]"
             )));
         }
         self.angles.push(AngleConstraint {
@@ -546,10 +546,11 @@ impl ParticleWorld {
                 let c = self.pos[ac.center];
                 let (da, db) = (self.pos[ac.a] - c, self.pos[ac.b] - c);
                 let angle = da.angle_between(db);
-                if !angle.is_finite() || (angle >= ac.min && angle <= ac.max) {
+                let (lo, hi) = (ac.min.to_radians(), ac.max.to_radians());
+                if !angle.is_finite() || (angle >= lo && angle <= hi) {
                     continue;
                 }
-                let target = angle.clamp(ac.min, ac.max);
+                let target = angle.clamp(lo, hi);
                 let axis = normalize_or(da.cross(db), da.any_orthonormal_vector());
                 // Turn each arm by half the excess, in opposite directions.
                 let half = 0.5 * (angle - target);

@@ -326,12 +326,13 @@ impl VrmSpringBones {
 pub enum VrmMode {
     /// The specification's algorithm once per frame with the frame's `dt`, exactly as the
     /// specification and UniVRM run it (three-vrm too, but for its bone length: see
-    /// [`VrmMode::ThreeVrm`]); the look depends on the frame rate.
-    #[default]
+    /// [`VrmMode::ThreeVrm`]); the look depends on the frame rate. Ask for it by name for
+    /// parity with the specification.
     Spec,
     /// The same update at a fixed internal rate, inputs interpolated within the frame and
     /// output interpolated between the last two steps: the look does not depend on the
-    /// frame rate.
+    /// frame rate. The default.
+    #[default]
     Fixed,
     /// three-vrm 3.5.5 as a web app runs it (`vrm.update(dt)`, then the render updates the
     /// world matrices): the specification's update once per frame, but each bone's length
@@ -342,7 +343,8 @@ pub enum VrmMode {
     ThreeVrm,
 }
 
-/// Runtime options of the spring-bone solver (not part of the file).
+/// Runtime options of the spring-bone solver (not part of the file). The default steps
+/// [`VrmMode::Fixed`]; [`VrmOptions::spec`] gives the specification's stepping.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct VrmOptions {
@@ -361,7 +363,7 @@ pub struct VrmOptions {
 impl Default for VrmOptions {
     fn default() -> Self {
         Self {
-            mode: VrmMode::Spec,
+            mode: VrmMode::Fixed,
             step_rate: 60.0,
             max_steps_per_frame: 8,
             teleport_distance: 0.0,
@@ -370,6 +372,14 @@ impl Default for VrmOptions {
 }
 
 impl VrmOptions {
+    /// The default options with the specification's stepping ([`VrmMode::Spec`]).
+    pub fn spec() -> Self {
+        Self {
+            mode: VrmMode::Spec,
+            ..Self::default()
+        }
+    }
+
     /// Checks the options.
     pub fn validate(&self) -> Result<()> {
         if !(self.step_rate.is_finite() && (10.0..=1000.0).contains(&self.step_rate)) {
