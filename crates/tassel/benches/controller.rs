@@ -4,7 +4,7 @@
 //! the set-up).
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use glam::Vec3;
+use glam::{Quat, Vec3};
 use std::hint::black_box;
 use tassel::builtin::level::{bench_level, STAIRS};
 use tassel::controller::{CharacterCapsule, ControllerSettings, Level};
@@ -73,5 +73,36 @@ fn controller(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, controller);
+/// Moving 10 colliders of the 1 000-collider level by one frame's motion: `set_pose`
+/// (each leaf updated in place in the BVH) against building the level again.
+fn level_edit(c: &mut Criterion) {
+    let colliders = bench_level(1000, 7);
+    let mut level = Level::new(colliders.clone()).unwrap();
+    let movers: Vec<usize> = (0..10).map(|i| 100 + 90 * i).collect();
+    let mut g = c.benchmark_group("level_edit_10_of_1000");
+    let mut t = 0.0f32;
+    g.bench_function("set_pose", |b| {
+        b.iter(|| {
+            t += 1.0 / 60.0;
+            level.start_frame();
+            for &id in &movers {
+                let p = colliders[id].position + Vec3::new(t.sin(), 0.0, t.cos());
+                level.set_pose(id, p, Quat::IDENTITY).unwrap();
+            }
+        })
+    });
+    g.bench_function("rebuild", |b| {
+        b.iter(|| {
+            t += 1.0 / 60.0;
+            let mut moved = colliders.clone();
+            for &id in &movers {
+                moved[id].position += Vec3::new(t.sin(), 0.0, t.cos());
+            }
+            black_box(Level::new(moved).unwrap())
+        })
+    });
+    g.finish();
+}
+
+criterion_group!(benches, controller, level_edit);
 criterion_main!(benches);

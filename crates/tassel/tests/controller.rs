@@ -199,13 +199,12 @@ fn climbs_small_stairs_and_is_blocked_by_high_ones() {
 
 /// A ramp rising along +z from z = `z0`, with a platform at its top.
 fn ramp_level(angle_deg: f32, length: f32, z0: f32) -> (Level, f32) {
-    let angle = angle_deg.to_radians();
-    let height = length * angle.tan();
+    let height = length * angle_deg.to_radians().tan();
     let level = Level::new(vec![
         floor(),
         LevelCollider::new(
             "ramp",
-            LevelShape::ramp_with_angle(4.0, length, angle),
+            LevelShape::ramp_with_angle(4.0, length, angle_deg),
             Vec3::new(0.0, 0.0, z0),
         ),
         block(
@@ -489,6 +488,56 @@ fn walking_down_stairs_stays_grounded_on_every_frame() {
     }
 }
 
+/// Issue 18: walking down stairs, the skin correction after snapping pushed out along the
+/// upper step's rounded edge normal, which points forward: the character gained speed
+/// (+13 % on two frames per step). Walking down must never go faster than the input.
+#[test]
+fn walking_down_stairs_never_gains_speed() {
+    // Five 0.2 m steps down along +z: the top at 1 m up to z = 2, treads 0.3 m deep.
+    let mut colliders = vec![floor()];
+    colliders.push(block(
+        "top",
+        Vec3::new(-2.0, 0.0, -3.0),
+        Vec3::new(2.0, 1.0, 2.0),
+    ));
+    for i in 0..4 {
+        let z0 = 2.0 + i as f32 * 0.3;
+        colliders.push(block(
+            &format!("step {i}"),
+            Vec3::new(-2.0, 0.0, z0),
+            Vec3::new(2.0, 0.8 - i as f32 * 0.2, z0 + 0.3),
+        ));
+    }
+    let level = Level::new(colliders).unwrap();
+    for speed in [1.4f32, 2.5, 4.0] {
+        let mut w = Walker::standing_at(0.0, 1.01, 1.0);
+        w.grounded = true;
+        let start = w.pos.z;
+        let frames = (3.0 / speed / DT) as usize;
+        for f in 0..frames {
+            let m = w.step(&level, Vec3::new(0.0, 0.0, speed), DT);
+            assert!(
+                m.translation.z <= speed * DT * (1.0 + 1e-4),
+                "speed {speed}, frame {f} at {}: moved {} m forward, the input is {} m",
+                w.pos,
+                m.translation.z,
+                speed * DT
+            );
+            assert!(
+                m.translation.x.abs() < 1e-5,
+                "drifted sideways: {}",
+                m.translation
+            );
+        }
+        let travelled = w.pos.z - start;
+        assert!(
+            travelled <= frames as f32 * speed * DT + 1e-4,
+            "speed {speed}: {travelled} m in {frames} frames"
+        );
+        assert!(w.pos.z > 3.5, "did not get down: {}", w.pos);
+    }
+}
+
 #[test]
 fn same_inputs_same_bits() {
     let mut colliders = vec![floor()];
@@ -529,7 +578,7 @@ fn bad_input_is_an_error_not_a_panic() {
     let bad_pose = Transform::from_translation(Vec3::new(f32::INFINITY, 0.0, 0.0));
     assert!(err(s.move_shape(&level, &CAPSULE, &bad_pose, Vec3::ZERO, DT)).contains("pose"));
     let bad = ControllerSettings {
-        max_climb_angle: 2.0,
+        max_climb_angle: 120.0,
         ..s
     };
     assert!(

@@ -25,11 +25,13 @@
 //! assert!((pose.translation.y + m.translation.y - (0.9 + settings.skin)).abs() < 1e-3);
 //! ```
 
+mod carry;
 mod level;
 mod move_shape;
 mod narrow;
+mod segment_query;
 mod settings;
 
-pub use level::{Level, LevelCollider, LevelContact, LevelHit, LevelShape, RayHit};
+pub use level::{Level, LevelCollider, LevelContact, LevelHit, LevelShape, RayHit, DEFAULT_GROUPS};
 pub use move_shape::{ControllerHit, Movement};
 pub use settings::{CharacterCapsule, ControllerSettings};

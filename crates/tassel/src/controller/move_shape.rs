@@ -3,8 +3,12 @@
 //! ground and depenetration.
 //!
 //! One call, in order:
+//! 0. **Moving colliders** (moved since [`Level::start_frame`]): the one the character
+//!    stood on carries it (and turns it about `up`); one that swept into it pushes it along
+//!    its own motion (`carry`).
 //! 1. **Keep the skin**: a capsule inside geometry, or closer to it than `skin`, is pushed
-//!    out to the skin gap (straight up off walkable ground, along the normal otherwise).
+//!    out to the skin gap (straight up off walkable ground and step edges, along the
+//!    normal otherwise).
 //! 2. **Ground at the start** (contacts within two skins): stepping and snapping only
 //!    happen for a character that stood on walkable ground.
 //! 3. **Collide and slide**: sweep the remaining motion; stop `skin` short of the first
@@ -15,6 +19,7 @@
 //!    grounded and is not moving up; keep the skin again.
 //! 5. **Ground at the end**: `grounded`, `sliding` and the ground normal.
 
+use super::carry;
 use super::level::{segment, Level, LevelContact, LevelHit};
 use super::settings::{CharacterCapsule, ControllerSettings};
 use crate::error::{Error, Result};
@@ -56,14 +61,20 @@ pub struct Movement {
     pub depenetration: Vec3,
     /// Contacts met, in order.
     pub hits: Vec<ControllerHit>,
+    /// The moving collider that carried the character this frame (it stood on it when the
+    /// frame began); its motion is part of `translation`.
+    pub platform: Option<usize>,
+    /// How much that platform turned the character about `up` this frame: apply it to
+    /// the character's facing (identity without a turning platform).
+    pub platform_rotation: Quat,
 }
 
 impl Movement {
-    /// The slope under the character, radians from horizontal, measured against `up`.
+    /// The slope under the character, degrees from horizontal, measured against `up`.
     pub fn slope_angle(&self, up: Vec3) -> Option<f32> {
         let up = up.normalize_or(Vec3::Y);
         self.ground_normal
-            .map(|n| n.dot(up).clamp(-1.0, 1.0).acos())
+            .map(|n| n.dot(up).clamp(-1.0, 1.0).acos().to_degrees())
     }
 }
 
@@ -77,6 +88,7 @@ struct Ground {
 
 struct Mover<'a> {
     level: &'a Level,
+    mask: u32,
     radius: f32,
     half_height: f32,
     rotation: Quat,
@@ -103,7 +115,7 @@ impl Mover<'_> {
             return None;
         }
         let (a, b) = segment(pos, self.rotation, self.half_height);
-        self.level.cast(a, b, self.radius, t)
+        self.level.cast(a, b, self.radius, t, self.mask)
     }
 
     fn vertical(&self, v: Vec3) -> Vec3 {
@@ -124,7 +136,7 @@ impl Mover<'_> {
         let lift = self.s.skin.max(0.01);
         let origin = hit.point + away * 0.005 + self.up * lift;
         self.level
-            .ray(origin, -self.up, 3.0 * lift)
+            .ray_masked(origin, -self.up, 3.0 * lift, self.mask)
             .map(|r| r.normal)
     }
 
@@ -190,8 +202,14 @@ impl Mover<'_> {
     /// walkable ones (or step edges) first, the most level of them.
     fn support(&self, pos: Vec3, scratch: &mut Vec<LevelContact>) -> Option<Ground> {
         let (a, b) = segment(pos, self.rotation, self.half_height);
-        self.level
-            .contacts(a, b, self.radius, 2.0 * self.s.skin + 1e-3, scratch);
+        self.level.contacts(
+            a,
+            b,
+            self.radius,
+            2.0 * self.s.skin + 1e-3,
+            self.mask,
+            scratch,
+        );
         let mut best: Option<Ground> = None;
         for c in scratch.iter() {
             let rise = c.normal.dot(self.up);
@@ -227,13 +245,14 @@ impl Mover<'_> {
     }
 
     /// Pushes the capsule out of anything closer than the skin: straight up off walkable
-    /// ground (so that standing on a slope does not creep down it), along the contact
-    /// normal otherwise. The deepest contact first, a few rounds.
+    /// ground and step edges (so that standing on a slope does not creep down it, and
+    /// walking down stairs does not speed up), along the contact normal otherwise. The deepest contact first, a few rounds.
     fn keep_skin(&self, mut pos: Vec3, scratch: &mut Vec<LevelContact>) -> Vec3 {
         let skin = self.s.skin;
         for _ in 0..2 * self.s.iterations.max(4) {
             let (a, b) = segment(pos, self.rotation, self.half_height);
-            self.level.contacts(a, b, self.radius, skin - 1e-4, scratch);
+            self.level
+                .contacts(a, b, self.radius, skin - 1e-4, self.mask, scratch);
             let Some(c) = scratch
                 .iter()
                 .min_by(|x, y| x.distance.total_cmp(&y.distance))
@@ -242,7 +261,18 @@ impl Mover<'_> {
             };
             let deficit = skin - c.distance;
             let rise = c.normal.dot(self.up);
-            pos += if self.walkable(c.normal) {
+            // A step's edge under the capsule is ground too: pushing out along its rounded
+            // normal, which leans forward, would speed up a character walking down stairs.
+            let on_edge = || {
+                let hit = LevelHit {
+                    collider: c.collider,
+                    fraction: 0.0,
+                    point: c.point,
+                    normal: c.normal,
+                };
+                rise >= 0.2 && self.edge_floor(pos, &hit).is_some()
+            };
+            pos += if self.walkable(c.normal) || on_edge() {
                 self.up * (deficit / rise)
             } else {
                 c.normal * deficit
@@ -336,20 +366,38 @@ impl ControllerSettings {
         };
         let m = Mover {
             level,
+            mask: self.collide_with,
             radius: capsule.radius,
             half_height: capsule.half_height,
             rotation,
             s: self,
             up,
-            cos_climb: self.max_climb_angle.cos(),
-            cos_slide: self.min_slide_angle.cos(),
+            cos_climb: self.max_climb_angle.to_radians().cos(),
+            cos_slide: self.min_slide_angle.to_radians().cos(),
             bottom: capsule.half_total_height(),
         };
         let start = pose.translation;
         let mut out = Movement::default();
         let mut scratch = Vec::new();
-        let mut pos = m.keep_skin(start, &mut scratch);
-        out.depenetration = pos - start;
+        // Colliders moved this frame: the platform under the character carries it, the
+        // others push it along their motion where they swept into it.
+        let carried = carry::follow(
+            level,
+            &carry::Body {
+                radius: m.radius,
+                half_height: m.half_height,
+                rotation,
+                up,
+                cos_climb: m.cos_climb,
+                skin: self.skin,
+                mask: self.collide_with,
+            },
+            start,
+        );
+        out.platform = carried.platform;
+        out.platform_rotation = carried.turn;
+        let mut pos = m.keep_skin(carried.pos, &mut scratch);
+        out.depenetration = pos - carried.pos;
 
         let was_grounded = m.support(pos, &mut scratch).is_some_and(|g| g.walkable);
 

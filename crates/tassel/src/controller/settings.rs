@@ -60,11 +60,11 @@ pub struct ControllerSettings {
     /// Free room needed on top of a step, measured beyond the point where the capsule lands
     /// on it, metres (default 0.1, ≥ 0). Narrower ledges are not climbed.
     pub min_step_width: f32,
-    /// Steepest slope walked up, radians from horizontal (default 45°, in `[0, 90°]`).
+    /// Steepest slope walked up, degrees from horizontal (default 45, in `[0, 90]`).
     /// Steeper slopes block horizontal motion like walls.
     pub max_climb_angle: f32,
-    /// Slopes at least this steep, radians, make the character slide down under the
-    /// caller's downward motion (default 45°, in `[0, 90°]`). Gentler slopes hold it.
+    /// Slopes at least this steep, degrees, make the character slide down under the
+    /// caller's downward motion (default 45, in `[0, 90]`). Gentler slopes hold it.
     pub min_slide_angle: f32,
     /// Largest drop the character is pulled down onto the ground by when it was grounded
     /// and is not moving up, metres (default 0.3, ≥ 0): walking down stairs and slopes
@@ -73,6 +73,9 @@ pub struct ControllerSettings {
     /// Most sweeps per call for collide-and-slide (default 6, 1..=64). Each contact
     /// plane met (a wall, a corner's second wall, the floor) takes one.
     pub iterations: u32,
+    /// The collision groups the character collides with, one bit each (default all): a
+    /// level collider is solid for it when `collider.groups & collide_with != 0`.
+    pub collide_with: u32,
 }
 
 impl Default for ControllerSettings {
@@ -82,10 +85,11 @@ impl Default for ControllerSettings {
             skin: 0.01,
             max_step_height: 0.3,
             min_step_width: 0.1,
-            max_climb_angle: 45f32.to_radians(),
-            min_slide_angle: 45f32.to_radians(),
+            max_climb_angle: 45.0,
+            min_slide_angle: 45.0,
             snap_to_ground: 0.3,
             iterations: 6,
+            collide_with: u32::MAX,
         }
     }
 }
@@ -107,13 +111,12 @@ impl ControllerSettings {
                 return bad(format!("{name} {v} must be finite and ≥ 0"));
             }
         }
-        let right = std::f32::consts::FRAC_PI_2;
         for (name, v) in [
             ("max_climb_angle", self.max_climb_angle),
             ("min_slide_angle", self.min_slide_angle),
         ] {
-            if !(v.is_finite() && (0.0..=right).contains(&v)) {
-                return bad(format!("{name} {v} rad must be within 0..=π/2"));
+            if !(v.is_finite() && (0.0..=90.0).contains(&v)) {
+                return bad(format!("{name} {v}° must be within 0..=90 degrees"));
             }
         }
         if !(1..=64).contains(&self.iterations) {

@@ -44,7 +44,7 @@ impl WorldContact<'_> {
         let mut b = b0;
         let v = b - a;
         if v.length_squared() > 0.0 {
-            if let Some(hit) = self.level.cast(a, a, r, v) {
+            if let Some(hit) = self.level.cast(a, a, r, v, u32::MAX) {
                 let contact = a + v * hit.fraction;
                 let rest = b - contact;
                 b = contact + rest - hit.normal * rest.dot(hit.normal).min(0.0);

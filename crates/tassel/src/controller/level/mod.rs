@@ -1,6 +1,11 @@
-//! The static level the character controller moves through: colliders in a parry BVH, with
-//! the queries the controller needs (capsule sweep, ray, contacts). Every collider is split
-//! into primitives (a triangle mesh into its triangles), each a leaf of parry's BVH.
+//! The level the character controller moves through: colliders in a parry BVH, with the
+//! queries the controller needs (capsule sweep, ray, contacts). Every collider is split into
+//! primitives (a triangle mesh into its triangles), each a leaf of parry's BVH. Colliders
+//! can be added, removed and moved between frames ([`edit`]): the BVH leaves are updated in
+//! place, and a collider's motion during the frame is kept for the controller (moving
+//! platforms carry, doors push).
+
+mod edit;
 
 use super::narrow::{Prim, Separation};
 use crate::error::{Error, Result};
@@ -50,18 +55,18 @@ pub enum LevelShape {
 }
 
 impl LevelShape {
-    /// A ramp of the given slope angle (radians, in `(0, π/2)`) rising over `length`.
-    pub fn ramp_with_angle(width: f32, length: f32, angle: f32) -> Self {
+    /// A ramp of the given slope angle (degrees, in `(0, 90)`) rising over `length`.
+    pub fn ramp_with_angle(width: f32, length: f32, angle_deg: f32) -> Self {
         LevelShape::Ramp {
             width,
             length,
-            height: length * angle.tan(),
+            height: length * angle_deg.to_radians().tan(),
         }
     }
 }
 
-/// One static collider of a level: a name (for errors and hit reports), a shape and where
-/// it is.
+/// One collider of a level: a name (for errors and hit reports), a shape, where it is and
+/// the collision groups it belongs to.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LevelCollider {
     /// A name for messages.
@@ -72,7 +77,14 @@ pub struct LevelCollider {
     pub position: Vec3,
     /// World rotation of the collider's frame.
     pub rotation: Quat,
+    /// The collision groups it belongs to, one bit each (default [`DEFAULT_GROUPS`]). A
+    /// query sees it when `groups & mask != 0`, with the query's mask (the controller's
+    /// `collide_with`).
+    pub groups: u32,
 }
+
+/// The groups a collider belongs to unless told otherwise: group 0.
+pub const DEFAULT_GROUPS: u32 = 1;
 
 impl LevelCollider {
     /// A collider at `position` with no rotation.
@@ -82,7 +94,14 @@ impl LevelCollider {
             shape,
             position,
             rotation: Quat::IDENTITY,
+            groups: DEFAULT_GROUPS,
         }
+    }
+
+    /// The same collider in the collision groups `groups` (one bit each).
+    pub fn with_groups(mut self, groups: u32) -> Self {
+        self.groups = groups;
+        self
     }
 
     /// The same collider turned by `rotation` about its frame's origin.
@@ -95,7 +114,8 @@ impl LevelCollider {
 /// A shape-cast hit against the level.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LevelHit {
-    /// Index of the collider hit (the order given to [`Level::new`]).
+    /// Id of the collider hit (its index in the list given to [`Level::new`], or what
+    /// [`Level::add`] returned).
     pub collider: usize,
     /// Fraction of the cast translation travelled before contact, in `[0, 1]`.
     pub fraction: f32,
@@ -130,20 +150,38 @@ pub struct LevelContact {
     pub point: Vec3,
 }
 
-/// A static level: colliders split into primitives in a bounding-volume hierarchy
-/// (parry's BVH), built once.
+/// A level: colliders split into primitives in a bounding-volume hierarchy (parry's BVH).
+/// Colliders are known by id: their index in the list given to [`Level::new`], then what
+/// [`Level::add`] returns; an id is never reused after [`Level::remove`].
 pub struct Level {
-    colliders: Vec<LevelCollider>,
+    /// By collider id; `None` once removed.
+    slots: Vec<Option<Slot>>,
+    live: usize,
+    /// By primitive (BVH leaf); a removed collider's slots are reused.
     prims: Vec<Prim>,
+    /// The collider id of each primitive.
     owner: Vec<u32>,
+    /// The collision groups of each primitive's collider.
+    groups: Vec<u32>,
+    free: Vec<u32>,
     bvh: Bvh,
+    /// Colliders moved since [`Level::start_frame`].
+    moved: Vec<u32>,
+}
+
+/// One collider of the level, with its primitives and this frame's motion.
+struct Slot {
+    collider: LevelCollider,
+    prims: Vec<u32>,
+    /// Where it was at [`Level::start_frame`], when it moved since.
+    from: Option<(Vec3, Quat)>,
 }
 
 impl std::fmt::Debug for Level {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("Level")
-            .field("colliders", &self.colliders.len())
-            .field("primitives", &self.prims.len())
+            .field("colliders", &self.live)
+            .field("primitives", &(self.prims.len() - self.free.len()))
             .finish()
     }
 }
@@ -274,93 +312,127 @@ pub(crate) fn segment(centre: Vec3, rotation: Quat, half_height: f32) -> (Vec3, 
     (centre - axis, centre + axis)
 }
 
+/// The checks every collider passes before it enters a level.
+fn check_placement(c: &LevelCollider) -> Result<()> {
+    if !c.position.is_finite() || !c.rotation.is_finite() || c.rotation.length() < 1e-6 {
+        return Err(Error::InvalidParameter(format!(
+            "level collider '{}': position {} / rotation {} must be finite (rotation non-zero)",
+            c.name, c.position, c.rotation
+        )));
+    }
+    Ok(())
+}
+
+/// A primitive's BVH leaf box.
+fn leaf(p: &Prim) -> Aabb {
+    let (lo, hi) = p.bounds();
+    Aabb::new(lo, hi).loosened(1e-4)
+}
+
+/// The most primitives a level holds (BVH leaf indices are `u32`).
+const MAX_PRIMS: usize = u32::MAX as usize / 2;
+
 impl Level {
-    /// Builds a level from `colliders`. Errors name the collider and the problem
-    /// (non-finite placement, a non-positive size, a triangle naming a missing vertex).
+    /// Builds a level from `colliders` (their ids are their indices). Errors name the
+    /// collider and the problem (non-finite placement, a non-positive size, a triangle
+    /// naming a missing vertex).
     pub fn new(colliders: Vec<LevelCollider>) -> Result<Self> {
         let mut prims = Vec::new();
         let mut owner = Vec::new();
-        for (i, c) in colliders.iter().enumerate() {
-            if !c.position.is_finite() || !c.rotation.is_finite() || c.rotation.length() < 1e-6 {
+        let mut groups = Vec::new();
+        let mut slots = Vec::with_capacity(colliders.len());
+        for (i, c) in colliders.into_iter().enumerate() {
+            check_placement(&c)?;
+            let first = prims.len();
+            build_prims(&c, &mut prims)?;
+            if prims.len() > MAX_PRIMS {
                 return Err(Error::InvalidParameter(format!(
-                    "level collider '{}': position {} / rotation {} must be finite (rotation non-zero)",
-                    c.name, c.position, c.rotation
+                    "level has {} primitives; too many",
+                    prims.len()
                 )));
             }
-            build_prims(c, &mut prims)?;
             owner.resize(prims.len(), i as u32);
+            groups.resize(prims.len(), c.groups);
+            slots.push(Some(Slot {
+                collider: c,
+                prims: (first as u32..prims.len() as u32).collect(),
+                from: None,
+            }));
         }
-        if prims.len() > u32::MAX as usize / 2 {
-            return Err(Error::InvalidParameter(format!(
-                "level has {} primitives; too many",
-                prims.len()
-            )));
-        }
-        let leaves: Vec<Aabb> = prims
-            .iter()
-            .map(|p| {
-                let (lo, hi) = p.bounds();
-                Aabb::new(lo, hi).loosened(1e-4)
-            })
-            .collect();
+        let leaves: Vec<Aabb> = prims.iter().map(leaf).collect();
         let bvh = Bvh::from_leaves(BvhBuildStrategy::Binned, &leaves);
         Ok(Self {
-            colliders,
+            live: slots.len(),
+            slots,
             prims,
             owner,
+            groups,
+            free: Vec::new(),
             bvh,
+            moved: Vec::new(),
         })
     }
 
-    /// Number of colliders.
+    /// Number of colliders in the level.
     pub fn len(&self) -> usize {
-        self.colliders.len()
+        self.live
     }
 
     /// True without colliders.
     pub fn is_empty(&self) -> bool {
-        self.colliders.is_empty()
+        self.live == 0
     }
 
     /// Number of primitives (a triangle mesh counts its triangles).
     pub fn primitive_count(&self) -> usize {
-        self.prims.len()
+        self.prims.len() - self.free.len()
     }
 
-    /// The colliders, in the order given.
-    pub fn colliders(&self) -> &[LevelCollider] {
-        &self.colliders
+    /// The colliders in the level with their ids, in id order.
+    pub fn colliders(&self) -> impl Iterator<Item = (usize, &LevelCollider)> + '_ {
+        self.slots
+            .iter()
+            .enumerate()
+            .filter_map(|(i, s)| s.as_ref().map(|s| (i, &s.collider)))
     }
 
-    /// World-space bounds of collider `i` (min, max); `None` past the end.
-    pub fn bounds(&self, i: usize) -> Option<(Vec3, Vec3)> {
-        let mut out: Option<(Vec3, Vec3)> = None;
-        for (p, &o) in self.prims.iter().zip(&self.owner) {
-            if o as usize == i {
-                let (lo, hi) = p.bounds();
-                out = Some(match out {
-                    None => (lo, hi),
-                    Some((a, b)) => (a.min(lo), b.max(hi)),
-                });
-            }
-        }
-        out
+    /// Collider `id`, as it is now; `None` if there is none (never was, or removed).
+    pub fn collider(&self, id: usize) -> Option<&LevelCollider> {
+        self.slot(id).map(|s| &s.collider)
+    }
+
+    fn slot(&self, id: usize) -> Option<&Slot> {
+        self.slots.get(id).and_then(Option::as_ref)
+    }
+
+    /// World-space bounds of collider `id` (min, max); `None` if there is no such collider.
+    pub fn bounds(&self, id: usize) -> Option<(Vec3, Vec3)> {
+        let slot = self.slot(id)?;
+        slot.prims
+            .iter()
+            .map(|&k| self.prims[k as usize].bounds())
+            .reduce(|(a, b), (lo, hi)| (a.min(lo), b.max(hi)))
     }
 
     /// Sweeps the capsule `a`–`b` of `radius` along `translation` and returns the first
     /// contact before its end. Contacts the motion leaves or slides along are ignored, so
-    /// a capsule resting on a floor walks on it. Ties go to the lower primitive.
+    /// a capsule resting on a floor walks on it. Ties go to the lower primitive. Only
+    /// colliders whose groups meet `mask` count.
     pub(crate) fn cast(
         &self,
         a: Vec3,
         b: Vec3,
         radius: f32,
         translation: Vec3,
+        mask: u32,
     ) -> Option<LevelHit> {
         let (lo, hi) = (a.min(b) - radius, a.max(b) + radius);
         let swept = Aabb::new(lo.min(lo + translation), hi.max(hi + translation)).loosened(1e-3);
         let mut best: Option<(f32, u32, Separation)> = None;
         for leaf in self.bvh.intersect_aabb(&swept) {
+            if self.groups[leaf as usize] & mask == 0 {
+                continue;
+            }
             let Some((t, s)) = self.prims[leaf as usize].sweep(a, b, radius, translation) else {
                 continue;
             };
@@ -399,13 +471,24 @@ impl Level {
             return None;
         }
         let (a, b) = segment(position, rotation.normalize(), half_height.max(0.0));
-        self.cast(a, b, radius.max(0.0), translation)
+        self.cast(a, b, radius.max(0.0), translation, u32::MAX)
     }
 
     /// Casts a ray from `origin` along unit `dir` up to `max_distance` metres: the first
     /// surface it reaches from outside. A ray that starts inside a solid reports nothing
     /// for that solid.
     pub fn ray(&self, origin: Vec3, dir: Vec3, max_distance: f32) -> Option<RayHit> {
+        self.ray_masked(origin, dir, max_distance, u32::MAX)
+    }
+
+    /// [`Level::ray`] seeing only the colliders whose groups meet `mask`.
+    pub fn ray_masked(
+        &self,
+        origin: Vec3,
+        dir: Vec3,
+        max_distance: f32,
+        mask: u32,
+    ) -> Option<RayHit> {
         if !(origin.is_finite() && dir.is_finite() && max_distance.is_finite()) {
             return None;
         }
@@ -417,6 +500,9 @@ impl Level {
         let bounds = Aabb::new(origin.min(origin + v), origin.max(origin + v)).loosened(1e-3);
         let mut best: Option<(f32, u32, Vec3)> = None;
         for leaf in self.bvh.intersect_aabb(&bounds) {
+            if self.groups[leaf as usize] & mask == 0 {
+                continue;
+            }
             let p = &self.prims[leaf as usize];
             if p.sdf(origin).0 < 0.0 {
                 continue;
@@ -436,19 +522,24 @@ impl Level {
     }
 
     /// Every primitive closer to the capsule `a`–`b` of `radius` than `within` metres
-    /// (negative distances are penetrations), in primitive order.
+    /// (negative distances are penetrations), by collider and distance; only colliders
+    /// whose groups meet `mask`.
     pub(crate) fn contacts(
         &self,
         a: Vec3,
         b: Vec3,
         radius: f32,
         within: f32,
+        mask: u32,
         out: &mut Vec<LevelContact>,
     ) {
         out.clear();
         let r = radius + within.max(0.0);
         let bounds = Aabb::new(a.min(b) - r, a.max(b) + r);
         for leaf in self.bvh.intersect_aabb(&bounds) {
+            if self.groups[leaf as usize] & mask == 0 {
+                continue;
+            }
             let s = self.prims[leaf as usize].separation(a, b, radius);
             if s.distance < within {
                 out.push(LevelContact {
@@ -500,7 +591,7 @@ impl Level {
     ) -> f32 {
         let (a, b) = segment(position, rotation, half_height);
         let mut out = Vec::new();
-        self.contacts(a, b, radius, 0.0, &mut out);
+        self.contacts(a, b, radius, 0.0, u32::MAX, &mut out);
         out.iter().map(|p| -p.distance).fold(0.0, f32::max)
     }
 }
