@@ -46,6 +46,7 @@
 mod assets;
 mod bind;
 mod character;
+mod controller;
 #[cfg(feature = "gizmos")]
 mod gizmos;
 mod step;
@@ -54,6 +55,7 @@ mod vrm_scene;
 
 pub use assets::{TasselAssetError, TasselModel, TasselModelLoader, TasselRig, TasselRigLoader};
 pub use character::{SecondaryMotion, TasselCharacter, TasselFailed};
+pub use controller::{CharacterController, TasselCollider, TasselLevel};
 #[cfg(feature = "gizmos")]
 pub use gizmos::TasselGizmosPlugin;
 pub use tassel;
@@ -71,15 +73,20 @@ pub mod prelude {
     #[cfg(feature = "gizmos")]
     pub use crate::TasselGizmosPlugin;
     pub use crate::{
-        SecondaryMotion, SimMode, TasselCharacter, TasselError, TasselFailed, TasselModel,
-        TasselPlugin, TasselRig, TasselSystems,
+        CharacterController, SecondaryMotion, SimMode, TasselCharacter, TasselCollider,
+        TasselError, TasselFailed, TasselLevel, TasselModel, TasselPlugin, TasselRig,
+        TasselSystems,
     };
 }
 
-/// The plugin's system sets, in `PostUpdate`, in this order, after
-/// [`AnimationSystems`] and before [`TransformSystems::Propagate`].
+/// The plugin's system sets, in `PostUpdate`, in this order, before
+/// [`TransformSystems::Propagate`]; `Bind` and `Step` after [`AnimationSystems`].
 #[derive(SystemSet, Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum TasselSystems {
+    /// The [`TasselLevel`] follows the [`TasselCollider`] entities (added, moved, removed).
+    Level,
+    /// Every [`CharacterController`] moves by its `desired` translation.
+    Control,
     /// Characters whose model, rig and bones are ready start.
     Bind,
     /// Every character reads its animated bones, steps, and writes the simulated ones.
@@ -110,16 +117,24 @@ impl Plugin for TasselPlugin {
             .register_asset_loader(TasselRigLoader)
             .add_message::<TasselError>()
             .init_resource::<bind::RigCache>()
+            .init_resource::<TasselLevel>()
             .configure_sets(
                 PostUpdate,
-                (TasselSystems::Bind, TasselSystems::Step)
+                (
+                    TasselSystems::Level,
+                    TasselSystems::Control,
+                    TasselSystems::Bind,
+                    TasselSystems::Step,
+                )
                     .chain()
-                    .after(AnimationSystems)
                     .before(TransformSystems::Propagate),
             )
+            .configure_sets(PostUpdate, TasselSystems::Bind.after(AnimationSystems))
             .add_systems(
                 PostUpdate,
                 (
+                    controller::sync_level.in_set(TasselSystems::Level),
+                    controller::move_characters.in_set(TasselSystems::Control),
                     bind::bind_characters.in_set(TasselSystems::Bind),
                     step::step_characters.in_set(TasselSystems::Step),
                 ),
