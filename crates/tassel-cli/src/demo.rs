@@ -282,7 +282,9 @@ pub fn run(a: Args) -> Result<(), String> {
             values,
         })
         .collect();
-    let png = draw_strip(&panels, &bands, &series, LevelRun::DURATION).png()?;
+    let png = draw_strip(&panels, &bands, &series, LevelRun::DURATION)
+        .png()
+        .map_err(|e| e.to_string())?;
     let glb_path = a.out.join("demo.glb");
     let png_path = a.out.join("demo.png");
     write_atomic(&glb_path, &glb)?;

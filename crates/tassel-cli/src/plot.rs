@@ -128,7 +128,7 @@ pub fn run(a: Args) -> Result<(), String> {
         y_label: format!("TIP DISPLACEMENT FROM THE ANIMATION ({units})"),
         series,
     };
-    let png = chart.draw(900, 480).png()?;
+    let png = chart.draw(900, 480).png().map_err(|e| e.to_string())?;
     write_atomic(&a.out, &png)?;
     let largest: Vec<String> = chart
         .series

@@ -116,9 +116,11 @@ pub fn run(a: Args) -> Result<(), String> {
             ));
         }
         let delay = (100.0 / a.gif_fps).round() as u16;
-        encode_gif(&animation_frames(&figures, &title), delay)?
+        encode_gif(&animation_frames(&figures, &title), delay).map_err(|e| e.to_string())?
     } else {
-        contact_sheet(&figures, &title).png()?
+        contact_sheet(&figures, &title)
+            .png()
+            .map_err(|e| e.to_string())?
     };
     write_atomic(&a.out, &bytes)?;
     say!(

@@ -1,6 +1,7 @@
 //! An RGB canvas with the few primitives the pictures need: filled discs, thick lines,
 //! circle outlines, rectangles and 5×7 text; PNG output.
 
+use crate::error::RenderError;
 use crate::font::{glyph, GLYPH};
 
 /// An RGB colour.
@@ -140,14 +141,15 @@ impl Canvas {
     }
 
     /// The canvas as PNG bytes.
-    pub fn png(&self) -> Result<Vec<u8>, String> {
+    pub fn png(&self) -> Result<Vec<u8>, RenderError> {
+        let bad = |e: png::EncodingError| RenderError::Png(e.to_string());
         let mut out = Vec::new();
         {
             let mut enc = png::Encoder::new(&mut out, self.w as u32, self.h as u32);
             enc.set_color(png::ColorType::Rgb);
             enc.set_depth(png::BitDepth::Eight);
-            let mut w = enc.write_header().map_err(|e| e.to_string())?;
-            w.write_image_data(&self.px).map_err(|e| e.to_string())?;
+            let mut w = enc.write_header().map_err(bad)?;
+            w.write_image_data(&self.px).map_err(bad)?;
         }
         Ok(out)
     }

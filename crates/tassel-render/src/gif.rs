@@ -3,19 +3,23 @@
 //! 3-3-2-bit colour cube.
 
 use crate::canvas::Canvas;
+use crate::error::RenderError;
 use std::borrow::Cow;
 use std::collections::HashMap;
 
 /// Encodes `frames` (all the same size) as a looping GIF, each shown `delay_cs`
 /// hundredths of a second.
-pub fn encode_gif(frames: &[Canvas], delay_cs: u16) -> Result<Vec<u8>, String> {
-    let first = frames.first().ok_or("a GIF needs at least one frame")?;
+pub fn encode_gif(frames: &[Canvas], delay_cs: u16) -> Result<Vec<u8>, RenderError> {
+    let bad = |m: String| RenderError::Gif(m);
+    let first = frames
+        .first()
+        .ok_or_else(|| bad("a GIF needs at least one frame".into()))?;
     let (w, h) = (first.width(), first.height());
     if frames.iter().any(|f| f.width() != w || f.height() != h) {
-        return Err("GIF frames differ in size".into());
+        return Err(bad("GIF frames differ in size".into()));
     }
     if w == 0 || h == 0 || w > u16::MAX as usize || h > u16::MAX as usize {
-        return Err(format!("a GIF cannot be {w} × {h} pixels"));
+        return Err(bad(format!("a GIF cannot be {w} × {h} pixels")));
     }
     let mut index: HashMap<[u8; 3], u8> = HashMap::new();
     let mut palette: Vec<u8> = Vec::new();
@@ -45,10 +49,10 @@ pub fn encode_gif(frames: &[Canvas], delay_cs: u16) -> Result<Vec<u8>, String> {
     }
     let mut out = Vec::new();
     {
-        let mut enc =
-            gif::Encoder::new(&mut out, w as u16, h as u16, &palette).map_err(|e| e.to_string())?;
+        let mut enc = gif::Encoder::new(&mut out, w as u16, h as u16, &palette)
+            .map_err(|e| bad(e.to_string()))?;
         enc.set_repeat(gif::Repeat::Infinite)
-            .map_err(|e| e.to_string())?;
+            .map_err(|e| bad(e.to_string()))?;
         for f in frames {
             let buffer: Vec<u8> = f
                 .pixels()
@@ -68,8 +72,31 @@ pub fn encode_gif(frames: &[Canvas], delay_cs: u16) -> Result<Vec<u8>, String> {
                 buffer: Cow::Owned(buffer),
                 ..gif::Frame::default()
             };
-            enc.write_frame(&frame).map_err(|e| e.to_string())?;
+            enc.write_frame(&frame).map_err(|e| bad(e.to_string()))?;
         }
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Bad frame lists are typed errors naming the problem, not panics.
+    #[test]
+    fn bad_frames_are_gif_errors() {
+        let is_gif_error = |r: Result<Vec<u8>, RenderError>, word: &str| matches!(r, Err(RenderError::Gif(m)) if m.contains(word));
+        assert!(is_gif_error(encode_gif(&[], 5), "at least one frame"));
+        let frames = [Canvas::new(4, 3, [255; 3]), Canvas::new(3, 4, [255; 3])];
+        assert!(is_gif_error(encode_gif(&frames, 5), "differ in size"));
+        // Two equal frames make a GIF: the header's magic and size by hand.
+        let ok = encode_gif(
+            &[Canvas::new(4, 3, [255; 3]), Canvas::new(4, 3, [255; 3])],
+            5,
+        )
+        .unwrap();
+        assert_eq!(&ok[..6], b"GIF89a");
+        assert_eq!(u16::from_le_bytes([ok[6], ok[7]]), 4);
+        assert_eq!(u16::from_le_bytes([ok[8], ok[9]]), 3);
+    }
 }

@@ -5,6 +5,7 @@
 
 mod canvas;
 mod chart;
+mod error;
 mod figure;
 mod font;
 mod gif;
@@ -13,6 +14,7 @@ mod strip;
 
 pub use canvas::{Canvas, Rgb};
 pub use chart::{ticks, Chart, ChartSeries, PALETTE};
+pub use error::RenderError;
 pub use figure::{outline, Bone, Figure, Outline};
 pub use gif::encode_gif;
 pub use sheet::{
