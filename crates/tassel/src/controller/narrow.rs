@@ -10,9 +10,9 @@
 //! method on a convex function of time, whose tangents never overshoot the first contact.
 
 use super::segment_query::{
-    closest_on_triangle, min_of_max_lines, segment_box_outside, segment_segment, segment_triangle,
+    closest_on_triangle, min_of_max_lines, segment_box_outside, segment_triangle,
 };
-use crate::math::{closest_point_on_segment, normalize_or};
+use crate::math::{closest_params_segment_segment, closest_point_on_segment, normalize_or};
 use glam::{Quat, Vec3};
 
 /// One level primitive, world space.
@@ -32,10 +32,12 @@ pub(crate) enum Prim {
         b: Vec3,
         radius: f32,
     },
-    /// A convex polyhedron: outward face planes `n·p = d` and its boundary triangulated.
+    /// A convex polyhedron: outward face planes `n·p = d` and its boundary triangulated,
+    /// with each triangle's unit normal (by its winding), computed once.
     Convex {
         planes: Vec<(Vec3, f32)>,
         triangles: Vec<[Vec3; 3]>,
+        normals: Vec<Vec3>,
     },
     Triangle {
         v: [Vec3; 3],
@@ -121,7 +123,9 @@ impl Prim {
                 let v = p - closest_point_on_segment(p, *a, *b);
                 (v.length() - radius, normalize_or(v, Vec3::Y))
             }
-            Prim::Convex { planes, triangles } => {
+            Prim::Convex {
+                planes, triangles, ..
+            } => {
                 let (mut best, mut normal) = (f32::NEG_INFINITY, Vec3::Y);
                 for (n, d) in planes {
                     let s = n.dot(p) - d;
@@ -190,7 +194,7 @@ impl Prim {
             Prim::Sphere { centre, .. } => {
                 (ab.dot(*centre - a) / ab.length_squared()).clamp(0.0, 1.0)
             }
-            Prim::Capsule { a: ca, b: cb, .. } => segment_segment(a, ab, *ca, *cb - *ca).0,
+            Prim::Capsule { a: ca, b: cb, .. } => closest_params_segment_segment(a, b, *ca, *cb).0,
             Prim::Triangle { v, normal } => segment_triangle(a, b, v, *normal).0,
             Prim::Cuboid {
                 centre,
@@ -214,7 +218,11 @@ impl Prim {
                     segment_box_outside(p0, d, *half)
                 }
             }
-            Prim::Convex { planes, triangles } => {
+            Prim::Convex {
+                planes,
+                triangles,
+                normals,
+            } => {
                 let (t, deepest) = min_of_max_lines(planes.len(), |i| {
                     let (pn, pd) = planes[i];
                     (pn.dot(a) - pd, pn.dot(ab))
@@ -223,8 +231,7 @@ impl Prim {
                     return t;
                 }
                 let mut best = (0.0, f32::INFINITY);
-                for tri in triangles {
-                    let n = (tri[1] - tri[0]).cross(tri[2] - tri[0]).normalize_or_zero();
+                for (tri, &n) in triangles.iter().zip(normals) {
                     let (t, d2) = segment_triangle(a, b, tri, n);
                     if d2 < best.1 {
                         best = (t, d2);
@@ -367,34 +374,19 @@ mod tests {
     fn closed_forms_match_the_search() {
         let mut r = crate::rng::SplitMix64::new(21);
         let mut v = |s: f32| Vec3::new(r.range_f32(-s, s), r.range_f32(-s, s), r.range_f32(-s, s));
-        let ramp = {
-            let (w, l, h) = (0.5f32, 1.5f32, 0.6f32);
-            let p = [
-                Vec3::new(-w, 0.0, 0.0),
-                Vec3::new(w, 0.0, 0.0),
-                Vec3::new(-w, 0.0, l),
-                Vec3::new(w, 0.0, l),
-                Vec3::new(-w, h, l),
-                Vec3::new(w, h, l),
-            ];
-            let faces: [&[Vec3]; 5] = [
-                &[p[0], p[1], p[3], p[2]],
-                &[p[2], p[3], p[5], p[4]],
-                &[p[0], p[4], p[5], p[1]],
-                &[p[0], p[2], p[4]],
-                &[p[1], p[5], p[3]],
-            ];
-            let mut planes = Vec::new();
-            let mut triangles = Vec::new();
-            for f in faces {
-                let n = (f[1] - f[0]).cross(f[2] - f[0]).normalize();
-                planes.push((n, n.dot(f[0])));
-                for k in 1..f.len() - 1 {
-                    triangles.push([f[0], f[k], f[k + 1]]);
-                }
-            }
-            Prim::Convex { planes, triangles }
-        };
+        // The ramp as the level builds it: a wedge 1 m wide, 1.5 m long, 0.6 m high.
+        let mut built = Vec::new();
+        let wedge = super::super::level::LevelCollider::new(
+            "ramp",
+            super::super::level::LevelShape::Ramp {
+                width: 1.0,
+                length: 1.5,
+                height: 0.6,
+            },
+            Vec3::ZERO,
+        );
+        super::super::level::build_prims(&wedge, &mut built).unwrap();
+        let ramp = built.pop().unwrap();
         let prims = [
             Prim::Cuboid {
                 centre: Vec3::new(0.1, -0.2, 0.3),

@@ -82,18 +82,23 @@ impl Level {
                 "level collider {id} does not exist"
             )));
         };
-        let mut moved = slot.collider.clone();
-        moved.position = position;
-        moved.rotation = rotation;
-        check_placement(&moved)?;
+        // Placed in the collider itself (no copy of its shape, which may be a large
+        // mesh), and put back if the new pose is refused.
+        let was = (slot.collider.position, slot.collider.rotation);
+        slot.collider.position = position;
+        slot.collider.rotation = rotation;
         let mut built = Vec::with_capacity(slot.prims.len());
-        build_prims(&moved, &mut built)?;
+        if let Err(e) =
+            check_placement(&slot.collider).and_then(|()| build_prims(&slot.collider, &mut built))
+        {
+            (slot.collider.position, slot.collider.rotation) = was;
+            return Err(e);
+        }
         debug_assert_eq!(built.len(), slot.prims.len());
         if slot.from.is_none() {
-            slot.from = Some((slot.collider.position, slot.collider.rotation.normalize()));
+            slot.from = Some((was.0, was.1.normalize()));
             self.moved.push(id as u32);
         }
-        slot.collider = moved;
         for (&k, p) in slot.prims.iter().zip(built) {
             self.bvh.insert(leaf(&p), k);
             self.prims[k as usize] = p;

@@ -198,10 +198,18 @@ fn convex(faces: &[&[Vec3]]) -> Prim {
             triangles.push([f[0], f[k], f[k + 1]]);
         }
     }
-    Prim::Convex { planes, triangles }
+    let normals = triangles
+        .iter()
+        .map(|t: &[Vec3; 3]| (t[1] - t[0]).cross(t[2] - t[0]).normalize_or_zero())
+        .collect();
+    Prim::Convex {
+        planes,
+        triangles,
+        normals,
+    }
 }
 
-fn build_prims(c: &LevelCollider, out: &mut Vec<Prim>) -> Result<()> {
+pub(super) fn build_prims(c: &LevelCollider, out: &mut Vec<Prim>) -> Result<()> {
     let bad = |what: String| {
         Err(Error::InvalidParameter(format!(
             "level collider '{}': {what}",
