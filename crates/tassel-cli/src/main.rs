@@ -14,6 +14,7 @@ macro_rules! say {
 mod bake;
 mod bench;
 mod demo;
+mod demo_look;
 mod inspect;
 mod output;
 mod plot;
@@ -39,9 +40,12 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Play the embedded character through a small level for 11.5 s (walk up stairs, run
-    /// down a ramp, jump a crate, slide along a wall) with its hair, tail, skirt, charm and
-    /// springs; write demo.glb (baked animation) and demo.png (side views and curves).
+    /// Play the embedded character through a small level for 18.5 s (walk up stairs, run
+    /// down a ramp, jump a crate, slide along a wall, go through a door that opens and
+    /// closes, ride a moving, turning platform) with its hair, tail, skirt, charm and
+    /// springs; write demo.glb (the level, the character's skinned body and the baked
+    /// animation, door and platform included) and demo.png (eight titled side views in the
+    /// level over a chart of the tips' distance from their animated place).
     Demo(demo::Args),
     /// A scripted, machine-readable run: joint positions per frame as JSON.
     Simulate(simulate::Args),

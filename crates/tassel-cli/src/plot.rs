@@ -127,6 +127,7 @@ pub fn run(a: Args) -> Result<(), String> {
         x_label: "TIME (S)".into(),
         y_label: format!("TIP DISPLACEMENT FROM THE ANIMATION ({units})"),
         series,
+        bands: vec![],
     };
     let png = chart.draw(900, 480).png().map_err(|e| e.to_string())?;
     write_atomic(&a.out, &png)?;

@@ -24,7 +24,8 @@ pub enum BoneMesh {
     /// Nodes only.
     None,
     /// A skinned octahedral "bone" from every joint to each child, so that any viewer
-    /// shows the skeleton move.
+    /// shows the skeleton move; links from a root joint at the origin (a root-motion bone
+    /// under the feet) are left out.
     Octahedra,
 }
 
@@ -103,6 +104,9 @@ fn add_bone_mesh(src: &mut ExportSource, sk: &Skeleton) {
     let mut idx: Vec<u16> = Vec::new();
     for c in 0..sk.len() {
         let Some(p) = sk.parent(c) else { continue };
+        if sk.parent(p).is_none() && rest.models[p].translation == Vec3::ZERO {
+            continue;
+        }
         let a = rest.models[p].translation;
         let b = rest.models[c].translation;
         let len = (b - a).length();
@@ -130,17 +134,13 @@ fn add_bone_mesh(src: &mut ExportSource, sk: &Skeleton) {
     let weights: Vec<f32> = (0..joints.len() / 4)
         .flat_map(|_| [1.0, 0.0, 0.0, 0.0])
         .collect();
-    let ibm: Vec<f32> = rest
-        .models
-        .iter()
-        .flat_map(|m| m.to_mat4().inverse().to_cols_array())
-        .collect();
     let (mut lo, mut hi) = (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN));
     for p in pos.chunks(3) {
         let p = Vec3::new(p[0], p[1], p[2]);
         lo = lo.min(p);
         hi = hi.max(p);
     }
+    let skin = skin_of(src, sk);
     let mut w = Writer::new(src);
     let a_pos = w.accessor(
         &f32_bytes(&pos),
@@ -162,38 +162,80 @@ fn add_bone_mesh(src: &mut ExportSource, sk: &Skeleton) {
     );
     let ib: Vec<u8> = idx.iter().flat_map(|j| j.to_le_bytes()).collect();
     let a_i = w.accessor(&ib, 5123, "SCALAR", idx.len(), None, Some(34963));
-    let a_ibm = w.accessor(&f32_bytes(&ibm), 5126, "MAT4", sk.len(), None, None);
     let json = &mut src.json;
-    json["meshes"] = json!([{ "name": "bones", "primitives": [ {
-        "attributes": { "POSITION": a_pos, "JOINTS_0": a_j, "WEIGHTS_0": a_w },
-        "indices": a_i,
-    } ] }]);
-    let root = (0..sk.len()).find(|&i| sk.parent(i).is_none()).unwrap_or(0);
-    json["skins"] = json!([{ "name": "skeleton", "joints": (0..sk.len()).collect::<Vec<_>>(), "inverseBindMatrices": a_ibm, "skeleton": root }]);
-    let mesh_node = json["nodes"].as_array().map(|a| a.len()).unwrap_or(0);
-    if let Some(a) = json["nodes"].as_array_mut() {
-        a.push(json!({ "name": "bones", "mesh": 0, "skin": 0 }));
-    }
+    let mesh = push_item(
+        json,
+        "meshes",
+        json!({ "name": "bones", "primitives": [ {
+            "attributes": { "POSITION": a_pos, "JOINTS_0": a_j, "WEIGHTS_0": a_w },
+            "indices": a_i,
+        } ] }),
+    );
+    let mesh_node = push_item(
+        json,
+        "nodes",
+        json!({ "name": "bones", "mesh": mesh, "skin": skin }),
+    );
     if let Some(a) = json["scenes"][0]["nodes"].as_array_mut() {
         a.push(json!(mesh_node));
     }
 }
 
-fn f32_bytes(v: &[f32]) -> Vec<u8> {
+/// Appends `item` to the array `json[key]` (made if missing) and returns its index.
+pub(crate) fn push_item(json: &mut Value, key: &str, item: Value) -> usize {
+    let Some(obj) = json.as_object_mut() else {
+        return 0;
+    };
+    let arr = obj.entry(key).or_insert(json!([]));
+    if !arr.is_array() {
+        *arr = json!([]);
+    }
+    let arr = arr.as_array_mut().expect("made an array above");
+    arr.push(item);
+    arr.len() - 1
+}
+
+/// The skin over every joint of `sk` (node index = joint index, bind pose = rest): the
+/// document's skin named "skeleton" if there is one, else a new one.
+pub(crate) fn skin_of(src: &mut ExportSource, sk: &Skeleton) -> usize {
+    if let Some(i) = src
+        .json
+        .get("skins")
+        .and_then(Value::as_array)
+        .and_then(|s| s.iter().position(|k| k["name"] == "skeleton"))
+    {
+        return i;
+    }
+    let rest = Pose::rest(sk);
+    let ibm: Vec<f32> = rest
+        .models
+        .iter()
+        .flat_map(|m| m.to_mat4().inverse().to_cols_array())
+        .collect();
+    let a_ibm = Writer::new(src).accessor(&f32_bytes(&ibm), 5126, "MAT4", sk.len(), None, None);
+    let root = (0..sk.len()).find(|&i| sk.parent(i).is_none()).unwrap_or(0);
+    push_item(
+        &mut src.json,
+        "skins",
+        json!({ "name": "skeleton", "joints": (0..sk.len()).collect::<Vec<_>>(), "inverseBindMatrices": a_ibm, "skeleton": root }),
+    )
+}
+
+pub(crate) fn f32_bytes(v: &[f32]) -> Vec<u8> {
     v.iter().flat_map(|x| x.to_le_bytes()).collect()
 }
 
 /// Appends data to buffer 0 of a source with one buffer.
-struct Writer<'a> {
+pub(crate) struct Writer<'a> {
     src: &'a mut ExportSource,
 }
 
 impl<'a> Writer<'a> {
-    fn new(src: &'a mut ExportSource) -> Self {
+    pub(crate) fn new(src: &'a mut ExportSource) -> Self {
         Self { src }
     }
 
-    fn view(&mut self, bytes: &[u8], target: Option<u32>) -> usize {
+    pub(crate) fn view(&mut self, bytes: &[u8], target: Option<u32>) -> usize {
         let bin = &mut self.src.buffers[0];
         while bin.len() % 4 != 0 {
             bin.push(0);
@@ -216,7 +258,7 @@ impl<'a> Writer<'a> {
         arr.len() - 1
     }
 
-    fn accessor(
+    pub(crate) fn accessor(
         &mut self,
         bytes: &[u8],
         component: u32,

@@ -5,7 +5,10 @@
 //!   (`VRMC_springBone` 1.0 with extended colliders, VRM 0.x `secondaryAnimation`).
 //! - [`export_glb`]: a GLB with the skeleton (and, when there was an input file, its
 //!   meshes, skins, materials and textures) plus baked animations, one key per frame;
-//!   baked keys can go into an input animation in place ([`BakedClip::merge_into`]).
+//!   baked keys can go into an input animation in place ([`BakedClip::merge_into`]);
+//!   a document built from a skeleton can get a controller level as meshes
+//!   ([`ExportSource::add_level`]) and a skinned body of tubes and sheets
+//!   ([`ExportSource::add_body`]).
 //! - [`bake_clip`]: play a clip through a [`tassel::CharacterSim`] and key the bones it
 //!   simulates.
 
@@ -18,6 +21,8 @@ mod error;
 mod export;
 mod import;
 mod mesh;
+mod scene;
+mod tessellate;
 mod uri;
 mod vrm;
 
@@ -28,4 +33,5 @@ pub use error::{GltfError, PlayError};
 pub use export::{export_glb, BakedClip, BakedTrack, BoneMesh, ExportSource};
 pub use import::{load, load_slice, Model, SkinInfo, MAX_FILE_BYTES};
 pub use mesh::MeshInstance;
+pub use scene::{Body, LevelPart, Limb, Material, Sheet};
 pub use vrm::{read_spring_bones, VrmInfo, VrmVersion, VRM0_TAIL_LENGTH};

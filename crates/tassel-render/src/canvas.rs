@@ -103,6 +103,49 @@ impl Canvas {
         }
     }
 
+    /// A filled polygon (any simple polygon, vertices in order; even–odd rule, pixel
+    /// centres inside are set).
+    pub fn polygon(&mut self, points: &[(f32, f32)], c: Rgb) {
+        if points.len() < 3 || points.iter().any(|p| !(p.0.is_finite() && p.1.is_finite())) {
+            return;
+        }
+        let (lo, hi) = points.iter().fold((f32::MAX, f32::MIN), |(lo, hi), p| {
+            (lo.min(p.1), hi.max(p.1))
+        });
+        let y0 = (lo.floor() as i64).max(0);
+        let y1 = (hi.ceil() as i64).min(self.h as i64 - 1);
+        let mut xs: Vec<f32> = Vec::new();
+        for y in y0..=y1 {
+            let yc = y as f32 + 0.5;
+            xs.clear();
+            for k in 0..points.len() {
+                let (a, b) = (points[k], points[(k + 1) % points.len()]);
+                if (a.1 <= yc) != (b.1 <= yc) {
+                    xs.push(a.0 + (yc - a.1) / (b.1 - a.1) * (b.0 - a.0));
+                }
+            }
+            xs.sort_by(f32::total_cmp);
+            for pair in xs.chunks_exact(2) {
+                let x0 = ((pair[0] - 0.5).ceil() as i64).max(0);
+                let x1 = ((pair[1] - 0.5).floor() as i64).min(self.w as i64 - 1);
+                for x in x0..=x1 {
+                    let i = (y as usize * self.w + x as usize) * 3;
+                    self.px[i..i + 3].copy_from_slice(&c);
+                }
+            }
+        }
+    }
+
+    /// Copies `other` with its top-left corner at (`x`, `y`) (clipped to this canvas).
+    pub fn blit(&mut self, other: &Canvas, x: usize, y: usize) {
+        for row in 0..other.h.min(self.h.saturating_sub(y)) {
+            let n = other.w.min(self.w.saturating_sub(x));
+            let src = row * other.w * 3;
+            let dst = ((y + row) * self.w + x) * 3;
+            self.px[dst..dst + n * 3].copy_from_slice(&other.px[src..src + n * 3]);
+        }
+    }
+
     /// A filled rectangle `[x0, x1) × [y0, y1)`.
     pub fn rect(&mut self, x0: usize, y0: usize, x1: usize, y1: usize, c: Rgb) {
         for y in y0..y1.min(self.h) {
@@ -190,6 +233,22 @@ mod tests {
         assert_eq!(c.get(4, 7), [255, 255, 255]);
         assert_eq!(c.get(5, 7), [0, 0, 0]);
         assert_eq!(Canvas::text_width("12", 2), 22);
+    }
+
+    #[test]
+    fn polygons_fill_their_inside_only() {
+        let mut c = Canvas::new(10, 10, [0, 0, 0]);
+        // A right triangle with legs along the top and left edges, 8 pixels long.
+        c.polygon(&[(1.0, 1.0), (9.0, 1.0), (1.0, 9.0)], [5, 5, 5]);
+        assert_eq!(c.get(2, 2), [5, 5, 5]);
+        assert_eq!(c.get(1, 7), [5, 5, 5]);
+        // Below the hypotenuse x + y = 10 (pixel centre 8.5 + 8.5 > 10).
+        assert_eq!(c.get(8, 8), [0, 0, 0]);
+        assert_eq!(c.get(0, 0), [0, 0, 0]);
+        let mut big = Canvas::new(4, 3, [1, 1, 1]);
+        big.blit(&c, 1, 1);
+        assert_eq!(big.get(0, 0), [1, 1, 1]);
+        assert_eq!(big.get(2, 2), c.get(1, 1));
     }
 
     #[test]

@@ -14,8 +14,19 @@ pub struct ChartSeries {
     pub points: Vec<(f32, f32)>,
 }
 
-/// A chart to draw.
+/// A stretch of the x axis shaded behind the lines, with a label at its top.
 #[derive(Debug, Clone, PartialEq)]
+pub struct Band {
+    /// Where it starts and ends on the x axis.
+    pub range: (f32, f32),
+    /// Its colour (light, behind the grid).
+    pub color: Rgb,
+    /// Written at the band's top left.
+    pub label: String,
+}
+
+/// A chart to draw.
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct Chart {
     /// Title over the plot.
     pub title: String,
@@ -25,6 +36,8 @@ pub struct Chart {
     pub y_label: String,
     /// The lines.
     pub series: Vec<ChartSeries>,
+    /// Shaded stretches of the x axis (e.g. the phases of a run), under everything else.
+    pub bands: Vec<Band>,
 }
 
 /// Distinct line colours for up to eight series (then repeated).
@@ -121,7 +134,15 @@ impl Chart {
         }
         let px = |x: f32| left as f32 + (x - x0) / (x1 - x0) * pw as f32;
         let py = |y: f32| (top + ph) as f32 - (y - y0) / (y1 - y0) * ph as f32;
-        // Grid and ticks.
+        // Bands, then grid and ticks.
+        for b in &self.bands {
+            let (a, z) = (b.range.0.max(x0), b.range.1.min(x1));
+            if z > a {
+                let (xa, xz) = (px(a).round() as usize, px(z).round() as usize);
+                c.rect(xa, top, xz, top + ph, b.color);
+                c.text(xa as i64 + 3, top as i64 + 3, &b.label, 1, [110, 110, 110]);
+            }
+        }
         let xt = ticks(x0, x1);
         let yt = ticks(y0, y1);
         let xstep = if xt.len() > 1 { xt[1] - xt[0] } else { 1.0 };
@@ -238,6 +259,7 @@ mod tests {
                 color: [200, 0, 0],
                 points: vec![(0.0, 0.5), (1.0, 0.5)],
             }],
+            bands: vec![],
         };
         let c = chart.draw(400, 300);
         // y range [0, 0.5 + 5 %]: 0.5 sits at 1/1.05 of the plot height above the axis.

@@ -289,6 +289,8 @@ fn in_the_demo_the_skirt_and_the_charm_touch_the_wall_and_never_enter_it() {
             let m = run
                 .frame(&c, &mut animator, f as f32 / fps, dt, &mut locals)
                 .unwrap();
+            // The door and the platform move: the solvers see this frame's level.
+            sim.set_level(Some(run.level.clone()));
             sim.frame(&locals, m.component, dt).unwrap();
             // The points the solvers move (not the skirt's waist ring nor the charm's
             // root: they follow the animation, and the animated left hand goes 35 mm into

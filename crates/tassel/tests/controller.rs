@@ -704,22 +704,30 @@ fn lift_sweep_drop_climbs_a_riser_met_with_the_straight_side() {
 }
 
 /// The demo's run through its level (`tassel demo`): up the stairs onto the 0.9 m
-/// platform, down the ramp, over the crate, along the wall, never inside anything.
+/// platform, down the ramp, over the crate, along the wall (facing along it, not where
+/// the input pushes), through the door while it is open, then carried and turned by the
+/// moving platform; never inside anything, the door and the platform where they are on
+/// each frame.
 #[test]
-fn the_demo_run_climbs_jumps_and_slides_through_its_level() {
-    use tassel::builtin::level::{LevelRun, CRATE, STAIRS};
+fn the_demo_run_climbs_jumps_slides_and_rides_through_its_level() {
+    use tassel::builtin::level::{moving_colliders, LevelRun, CRATE, DOOR, PLATFORM, STAIRS};
     use tassel::builtin::{self, DemoScript};
     let c = builtin::character();
     let mut animator = DemoScript.animator(&c);
     let mut run = LevelRun::new().unwrap();
     let mut locals = c.skeleton.rest().to_vec();
-    let frames = (LevelRun::DURATION / DT) as usize;
+    let frames = (LevelRun::DURATION / DT).round() as usize;
     let (count, rise, tread, z0) = STAIRS;
     let top = count as f32 * rise;
     // The platform past the last stair runs 3.5 m.
     let platform = z0 + count as f32 * tread + 0.5..z0 + count as f32 * tread + 3.0;
     let (mut on_platform, mut states) = (0, Vec::new());
-    let mut end = Vec3::ZERO;
+    let mut through_door = false;
+    // The feet in the moving platform's frame, from the frame the ride starts.
+    let mut on_ride: Option<Vec3> = None;
+    let (mut ride_frames, mut ride_drift) = (0, 0.0f32);
+    let mut facing_at_ride = Quat::IDENTITY;
+    let mut end = Transform::IDENTITY;
     for f in 0..=frames {
         let t = f as f32 * DT;
         let m = run
@@ -732,8 +740,8 @@ fn the_demo_run_climbs_jumps_and_slides_through_its_level() {
             )
             .unwrap();
         let feet = m.component.translation;
-        end = feet;
-        if platform.contains(&feet.z) {
+        end = m.component;
+        if platform.contains(&feet.z) && t < 8.0 {
             on_platform += 1;
             assert!(
                 (feet.y - top).abs() < 2e-3,
@@ -756,15 +764,59 @@ fn the_demo_run_climbs_jumps_and_slides_through_its_level() {
         if (CRATE.0..CRATE.0 + 0.6).contains(&feet.z) {
             assert!(feet.y > CRATE.1, "t = {t}: feet at {feet} over the crate");
         }
+        // Sliding along the wall (pressed to it, the input 45° into it): it faces along
+        // the wall within 2°, i.e. where it goes.
+        if (9.6..10.6).contains(&t) {
+            let x = 1.2 - run.capsule.radius - run.settings.skin;
+            assert!((feet.x - x).abs() < 1e-3, "t = {t}: off the wall at {feet}");
+            let forward = m.component.rotation * Vec3::Z;
+            assert!(
+                forward.angle_between(Vec3::Z) < 2f32.to_radians(),
+                "t = {t}: faces {forward} while sliding along +z"
+            );
+        }
+        // In the door's plane only while it is open (its bottom above the head).
+        if (DOOR.0..DOOR.0 + DOOR.1).contains(&feet.z) {
+            through_door = true;
+            let (_, door, _) = moving_colliders(t)[0];
+            assert!(door.y - 0.5 * DOOR.2 > 1.8, "t = {t}: under a closed door");
+        }
+        // The ride (the platform moves from 14.8 s to 17.8 s): the feet keep their place
+        // on the platform within 1 mm, and the facing turns with it.
+        let (_, p, r) = moving_colliders(t)[1];
+        let local = r.inverse() * (feet - p);
+        if t >= 14.7 {
+            match on_ride {
+                None => {
+                    on_ride = Some(local);
+                    facing_at_ride = m.component.rotation;
+                    assert!(
+                        (local.y - PLATFORM.1.y).abs() < 2e-3,
+                        "t = {t}: not on the platform: {local}"
+                    );
+                }
+                Some(first) => {
+                    ride_frames += 1;
+                    ride_drift = ride_drift.max((local - first).length());
+                }
+            }
+        }
     }
     assert!(on_platform > 10, "{on_platform} frames on the platform");
     assert!(
         states.iter().any(|s| s.starts_with("jump_loop")),
         "{states:?}"
     );
-    // Ends pressed against the wall (near face x = 1.2), having slid along it.
-    let x = 1.2 - run.capsule.radius - run.settings.skin;
-    assert!((end.x - x).abs() < 1e-3, "ends at {end}");
-    assert!(end.z > CRATE.0 + 3.0);
+    assert!(through_door, "never went through the door");
+    assert!(ride_frames > 200);
+    assert!(ride_drift < 1e-3, "slid {ride_drift} m on the platform");
+    // The platform turned a quarter turn; so did the character.
+    let turned = end.rotation * facing_at_ride.inverse();
+    let (axis, angle) = turned.to_axis_angle();
+    assert!(
+        (angle - 90f32.to_radians()).abs() < 0.5f32.to_radians() && axis.y > 0.999,
+        "turned {}° about {axis}",
+        angle.to_degrees()
+    );
     assert!(run.last.grounded);
 }

@@ -152,7 +152,9 @@ pub struct LevelContact {
 
 /// A level: colliders split into primitives in a bounding-volume hierarchy (parry's BVH).
 /// Colliders are known by id: their index in the list given to [`Level::new`], then what
-/// [`Level::add`] returns; an id is never reused after [`Level::remove`].
+/// [`Level::add`] returns; an id is never reused after [`Level::remove`]. A clone is a
+/// deep copy (e.g. `Arc::make_mut` on a level the controller and a character share).
+#[derive(Clone)]
 pub struct Level {
     /// By collider id; `None` once removed.
     slots: Vec<Option<Slot>>,
@@ -170,6 +172,7 @@ pub struct Level {
 }
 
 /// One collider of the level, with its primitives and this frame's motion.
+#[derive(Clone)]
 struct Slot {
     collider: LevelCollider,
     prims: Vec<u32>,
