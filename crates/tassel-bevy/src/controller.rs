@@ -205,16 +205,21 @@ pub(crate) fn move_characters(
             scale: Vec3::ONE,
         };
         let c = &mut *c;
-        match c
-            .settings
-            .move_shape(&level.level, &c.capsule, &pose, c.desired, dt)
-        {
-            Ok(m) => {
+        // Into the component's last movement: its buffers are reused, no allocation.
+        match c.settings.move_shape_into(
+            &level.level,
+            &c.capsule,
+            &pose,
+            c.desired,
+            dt,
+            &mut c.last,
+        ) {
+            Ok(()) => {
+                let m = &c.last;
                 t.translation += m.translation;
                 if m.platform_rotation != Quat::IDENTITY {
                     t.rotation = (m.platform_rotation * t.rotation).normalize();
                 }
-                c.last = m;
                 c.desired = Vec3::ZERO;
             }
             Err(e) => {

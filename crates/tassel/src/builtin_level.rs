@@ -363,12 +363,15 @@ impl LevelRun {
             self.vy -= GRAVITY * dt;
             let forward = Quat::from_rotation_y(self.yaw) * Vec3::Z;
             let desired = forward * speed * dt + Vec3::Y * self.vy * dt;
-            let m = self.settings.move_shape(
+            // Into the last movement: its hit buffer is reused.
+            let mut m = std::mem::take(&mut self.last);
+            self.settings.move_shape_into(
                 &self.level,
                 &self.capsule,
                 &Transform::from_translation(self.centre),
                 desired,
                 dt,
+                &mut m,
             )?;
             self.centre += m.translation;
             self.grounded = m.grounded;

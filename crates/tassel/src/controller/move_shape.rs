@@ -347,6 +347,41 @@ impl ControllerSettings {
         desired: Vec3,
         dt: f32,
     ) -> Result<Movement> {
+        let mut out = Movement::default();
+        self.move_shape_into(level, capsule, pose, desired, dt, &mut out)?;
+        Ok(out)
+    }
+
+    /// [`ControllerSettings::move_shape`] into `out`, whose `hits` buffer is reused: once
+    /// it and this thread's contact buffer have grown to what the level needs, a call
+    /// allocates nothing (a game keeps one `Movement` per character). On error `out` is
+    /// left as it was.
+    pub fn move_shape_into(
+        &self,
+        level: &Level,
+        capsule: &CharacterCapsule,
+        pose: &Transform,
+        desired: Vec3,
+        dt: f32,
+        out: &mut Movement,
+    ) -> Result<()> {
+        CONTACTS.with_borrow_mut(|scratch| {
+            scratch.clear();
+            self.move_with(level, capsule, pose, desired, dt, out, scratch)
+        })
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn move_with(
+        &self,
+        level: &Level,
+        capsule: &CharacterCapsule,
+        pose: &Transform,
+        desired: Vec3,
+        dt: f32,
+        out: &mut Movement,
+        scratch: &mut Vec<LevelContact>,
+    ) -> Result<()> {
         self.validate()?;
         capsule.validate()?;
         if !dt.is_finite() || dt < 0.0 {
@@ -377,8 +412,12 @@ impl ControllerSettings {
             bottom: capsule.half_total_height(),
         };
         let start = pose.translation;
-        let mut out = Movement::default();
-        let mut scratch = Vec::new();
+        let mut hits = std::mem::take(&mut out.hits);
+        hits.clear();
+        *out = Movement {
+            hits,
+            ..Movement::default()
+        };
         // Colliders moved this frame: the platform under the character carries it, the
         // others push it along their motion where they swept into it.
         let carried = carry::follow(
@@ -396,10 +435,10 @@ impl ControllerSettings {
         );
         out.platform = carried.platform;
         out.platform_rotation = carried.turn;
-        let mut pos = m.keep_skin(carried.pos, &mut scratch);
+        let mut pos = m.keep_skin(carried.pos, scratch);
         out.depenetration = pos - carried.pos;
 
-        let was_grounded = m.support(pos, &mut scratch).is_some_and(|g| g.walkable);
+        let was_grounded = m.support(pos, scratch).is_some_and(|g| g.walkable);
 
         // Collide and slide.
         let total = desired.length();
@@ -518,7 +557,7 @@ impl ControllerSettings {
 
         // Snap down onto the ground when walking off a step or over a crest.
         if was_grounded && !out.stepped && desired.dot(up) <= 1e-6 && self.snap_to_ground > 0.0 {
-            let here = m.support(pos, &mut scratch);
+            let here = m.support(pos, scratch);
             if !here.is_some_and(|g| g.walkable) {
                 if let Some(g) = m.ground(pos, self.snap_to_ground + self.skin) {
                     if g.walkable {
@@ -528,15 +567,22 @@ impl ControllerSettings {
                 }
             }
         }
-        pos = m.keep_skin(pos, &mut scratch);
+        pos = m.keep_skin(pos, scratch);
 
-        if let Some(g) = m.support(pos, &mut scratch) {
+        if let Some(g) = m.support(pos, scratch) {
             out.ground_normal = Some(g.normal);
             out.grounded = g.walkable;
             let rise = g.normal.dot(up);
             out.sliding = rise > 1e-4 && rise <= m.cos_slide + 1e-5;
         }
         out.translation = pos - start;
-        Ok(out)
+        Ok(())
     }
+}
+
+thread_local! {
+    /// The contact buffer of every `move_shape` call on this thread, kept between calls so
+    /// that a call allocates nothing once it has grown.
+    static CONTACTS: std::cell::RefCell<Vec<LevelContact>> =
+        const { std::cell::RefCell::new(Vec::new()) };
 }
