@@ -122,7 +122,8 @@ impl ExportSource {
     /// rotation, with the collider's shape in the node's frame (boxes, wedges and triangle
     /// meshes exactly, spheres and capsules as 12-sided meshes that reach their true
     /// extent along the collider's axes). Returns the node index of each part, in order
-    /// (to animate a moving collider). Errors for a material index out of range.
+    /// (to animate a moving collider). Errors, before anything is written, for a material
+    /// index out of range, a non-finite placement or a part without triangles.
     pub fn add_level(
         &mut self,
         parts: &[LevelPart<'_>],
@@ -136,15 +137,30 @@ impl ExportSource {
                 materials.len()
             )));
         }
-        let first_material = self.add_materials(materials);
-        let mut nodes = Vec::with_capacity(parts.len());
+        // Every shape is made before anything is written: an error leaves `self` as it was.
+        let mut shapes = Vec::with_capacity(parts.len());
         for part in parts {
             let c = part.collider;
-            let mut g = Geometry::default();
-            g.level_shape(&c.shape);
-            if g.triangles.is_empty() {
-                return Err(invalid(format!("level part '{}' has no triangles", c.name)));
+            if !(c.position.is_finite() && c.rotation.is_finite() && c.rotation.length() > 1e-6) {
+                return Err(invalid(format!(
+                    "level part '{}': position {} / rotation {} must be finite (rotation non-zero)",
+                    c.name, c.position, c.rotation
+                )));
             }
+            let mut g = Geometry::default();
+            g.level_shape(&part.collider.shape);
+            if g.triangles.is_empty() {
+                return Err(invalid(format!(
+                    "level part '{}' has no triangles",
+                    part.collider.name
+                )));
+            }
+            shapes.push(g);
+        }
+        let first_material = self.add_materials(materials);
+        let mut nodes = Vec::with_capacity(parts.len());
+        for (part, g) in parts.iter().zip(shapes) {
+            let c = part.collider;
             let prim = write_primitive(self, &g, None, first_material + part.material);
             let mesh = push_item(
                 &mut self.json,

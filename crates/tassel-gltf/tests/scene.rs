@@ -109,8 +109,26 @@ fn level_meshes_span_their_colliders() {
         collider: &cs[0],
         material: 3,
     }];
+    let before = src.json.clone();
     let e = src.add_level(&bad, &materials).unwrap_err().to_string();
     assert!(e.contains("'box'") && e.contains("material 3"), "{e}");
+    // A NaN placement (it would be written as null) is refused too, and nothing of the
+    // level before it is written.
+    let mut nan = cs[4].clone();
+    nan.position.y = f32::NAN;
+    let bad = [
+        LevelPart {
+            collider: &cs[0],
+            material: 0,
+        },
+        LevelPart {
+            collider: &nan,
+            material: 0,
+        },
+    ];
+    let e = src.add_level(&bad, &materials).unwrap_err().to_string();
+    assert!(e.contains("'rock'") && e.contains("finite"), "{e}");
+    assert_eq!(src.json, before);
 }
 
 /// A two-bone arm: shoulder at the origin, elbow 1 m along +x, a limb on each.
