@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{tassel, tmp, validate};
+use common::{read_png, tassel, tmp, validate};
 use glam::{Quat, Vec3};
 use serde_json::Value;
 use std::path::Path;
@@ -219,16 +219,6 @@ fn demo_glb_has_the_level_where_it_is_its_motion_and_a_skinned_body() {
     if let Some(report) = validate(&dir.join("demo.glb")) {
         assert!(report.contains("\"errors\":0"), "{report}");
     }
-}
-
-fn read_png(path: &Path) -> (usize, usize, Vec<u8>) {
-    let dec = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(path).unwrap()));
-    let mut r = dec.read_info().unwrap();
-    let mut buf = vec![0; r.output_buffer_size().unwrap()];
-    let info = r.next_frame(&mut buf).unwrap();
-    assert_eq!(info.color_type, png::ColorType::Rgb);
-    buf.truncate(info.buffer_size());
-    (info.width as usize, info.height as usize, buf)
 }
 
 #[test]

@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{tassel, testdata, tmp};
+use common::{read_png, tassel, testdata, tmp};
 use std::path::{Path, PathBuf};
 
 const SIMULATED: [u8; 3] = [235, 110, 30];
@@ -12,16 +12,6 @@ const BG: [u8; 3] = [250, 250, 248];
 
 fn fox_rig() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/rigs/fox.toml")
-}
-
-fn read_png(path: &Path) -> (usize, usize, Vec<u8>) {
-    let dec = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(path).unwrap()));
-    let mut r = dec.read_info().unwrap();
-    let mut buf = vec![0; r.output_buffer_size().unwrap()];
-    let info = r.next_frame(&mut buf).unwrap();
-    assert_eq!(info.color_type, png::ColorType::Rgb);
-    buf.truncate(info.buffer_size());
-    (info.width as usize, info.height as usize, buf)
 }
 
 fn run_ok(args: &[&std::ffi::OsStr]) {

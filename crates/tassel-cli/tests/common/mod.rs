@@ -113,3 +113,14 @@ pub fn accessor_bytes<'a>(json: &serde_json::Value, bin: &'a [u8], a: usize) -> 
     let len = view["byteLength"].as_u64().unwrap() as usize;
     &bin[start..start + len]
 }
+
+/// An RGB PNG as (width, height, row-major RGB bytes).
+pub fn read_png(path: &Path) -> (usize, usize, Vec<u8>) {
+    let dec = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(path).unwrap()));
+    let mut r = dec.read_info().unwrap();
+    let mut buf = vec![0; r.output_buffer_size().unwrap()];
+    let info = r.next_frame(&mut buf).unwrap();
+    assert_eq!(info.color_type, png::ColorType::Rgb);
+    buf.truncate(info.buffer_size());
+    (info.width as usize, info.height as usize, buf)
+}
