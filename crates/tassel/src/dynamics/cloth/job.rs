@@ -505,8 +505,17 @@ fn collide(
             }
             let (a, b) = (c.a as usize, c.b as usize);
             let r = 0.5 * (rig.radius[a] + rig.radius[b]);
+            let (lo, hi) = (pos[a].min(pos[b]), pos[a].max(pos[b]));
             for &k in &cloth.colliders {
                 if let Some((e0, e1, radius)) = core(&colliders[k]) {
+                    // Quick rejection, exact: boxes around the two segments farther apart
+                    // on some axis than the contact distance (with 1e-4 m to spare for
+                    // rounding) mean the exact test below finds no contact either.
+                    let reach = radius + r + 1e-4;
+                    let gap = (lo - e0.max(e1)).max(e0.min(e1) - hi);
+                    if gap.max_element() > reach {
+                        continue;
+                    }
                     let (mut pa, mut pb) = (pos[a], pos[b]);
                     if push_segment(
                         &mut pa,
