@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{read_png, tassel, tmp, validate};
+use common::{glb_chunks, read_floats, read_png, read_u16s, run_ok, tassel, tmp, validate};
 use glam::{Quat, Vec3};
 use serde_json::Value;
 use std::path::Path;
@@ -13,57 +13,17 @@ use tassel::builtin::level::{demo_level, moving_colliders};
 use tassel::controller::Level;
 
 fn run_demo(dir: &Path, extra: &[&str]) {
-    let out = tassel()
-        .args(["demo", "--out"])
-        .arg(dir)
-        .args(extra)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    run_ok(tassel().args(["demo", "--out"]).arg(dir).args(extra));
 }
 
-/// The GLB's JSON and BIN chunks, read by hand.
-fn chunks(glb: &[u8]) -> (Value, Vec<u8>) {
-    let u32_at = |o: usize| u32::from_le_bytes(glb[o..o + 4].try_into().unwrap()) as usize;
-    assert_eq!(&glb[0..4], b"glTF");
-    let json_len = u32_at(12);
-    let doc: Value = serde_json::from_slice(&glb[20..20 + json_len]).unwrap();
-    let bin_at = 20 + json_len;
-    let bin_len = u32_at(bin_at);
-    assert_eq!(&glb[bin_at + 4..bin_at + 8], b"BIN\0");
-    (doc, glb[bin_at + 8..bin_at + 8 + bin_len].to_vec())
-}
-
-/// Accessor `i` as f64 components (FLOAT or UNSIGNED_SHORT, tightly packed).
+/// Accessor `i` as f64 components (FLOAT or UNSIGNED_SHORT), read by hand.
 fn read(doc: &Value, bin: &[u8], i: usize) -> Vec<f64> {
-    let a = &doc["accessors"][i];
-    let v = &doc["bufferViews"][a["bufferView"].as_u64().unwrap() as usize];
-    let start = v["byteOffset"].as_u64().unwrap_or(0) as usize
-        + a["byteOffset"].as_u64().unwrap_or(0) as usize;
-    let comps = match a["type"].as_str().unwrap() {
-        "SCALAR" => 1,
-        "VEC3" => 3,
-        "VEC4" => 4,
-        "MAT4" => 16,
-        t => panic!("{t}"),
-    };
-    let n = a["count"].as_u64().unwrap() as usize * comps;
-    match a["componentType"].as_u64().unwrap() {
-        5126 => (0..n)
-            .map(|k| {
-                f32::from_le_bytes(bin[start + 4 * k..start + 4 * k + 4].try_into().unwrap()) as f64
-            })
+    match doc["accessors"][i]["componentType"].as_u64().unwrap() {
+        5123 => read_u16s(doc, bin, i).into_iter().map(f64::from).collect(),
+        _ => read_floats(doc, bin, i)
+            .into_iter()
+            .map(f64::from)
             .collect(),
-        5123 => (0..n)
-            .map(|k| {
-                u16::from_le_bytes(bin[start + 2 * k..start + 2 * k + 2].try_into().unwrap()) as f64
-            })
-            .collect(),
-        t => panic!("component type {t}"),
     }
 }
 
@@ -86,7 +46,7 @@ fn demo_glb_has_the_level_where_it_is_its_motion_and_a_skinned_body() {
     }
     let glb = std::fs::read(&path).unwrap();
     println!("demo.glb: {} bytes", glb.len());
-    let (doc, bin) = chunks(&glb);
+    let (doc, bin) = glb_chunks(&glb);
 
     // Every collider of the level is a mesh node whose vertices (the node's transform
     // applied, read back by the glTF importer) span the collider's bounds as the
@@ -214,7 +174,7 @@ fn demo_glb_has_the_level_where_it_is_its_motion_and_a_skinned_body() {
     // --bones adds the spikes (and the file still validates).
     let dir = tmp("demo-bones");
     run_demo(&dir, &["--bones"]);
-    let (doc, _) = chunks(&std::fs::read(dir.join("demo.glb")).unwrap());
+    let (doc, _) = glb_chunks(&std::fs::read(dir.join("demo.glb")).unwrap());
     assert!(node_named(&doc, "bones").is_some());
     if let Some(report) = validate(&dir.join("demo.glb")) {
         assert!(report.contains("\"errors\":0"), "{report}");

@@ -15,12 +15,7 @@ fn fox_rig() -> PathBuf {
 }
 
 fn run_ok(args: &[&std::ffi::OsStr]) {
-    let out = tassel().args(args).output().unwrap();
-    assert!(
-        out.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    common::run_ok(tassel().args(args));
 }
 
 #[test]

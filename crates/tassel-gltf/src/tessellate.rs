@@ -144,7 +144,8 @@ impl Geometry {
 
     /// A sphere of `radius` about `centre`, its poles on ±Y.
     pub fn sphere(&mut self, centre: Vec3, radius: f32) {
-        self.capsule(centre, centre + Vec3::Y * 1e-12, radius, radius);
+        // A capsule without length: its axis falls back to +Y.
+        self.capsule(centre, centre, radius, radius);
     }
 
     /// An axis-aligned box of `half` extents about the origin.

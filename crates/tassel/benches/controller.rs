@@ -6,9 +6,8 @@
 use criterion::{criterion_group, criterion_main, Criterion};
 use glam::{Quat, Vec3};
 use std::hint::black_box;
-use tassel::builtin::level::{bench_level, STAIRS};
+use tassel::builtin::level::{bench_level, bench_moves};
 use tassel::controller::{CharacterCapsule, ControllerSettings, Level};
-use tassel::Transform;
 
 fn controller(c: &mut Criterion) {
     let level = Level::new(bench_level(1000, 7)).unwrap();
@@ -16,60 +15,27 @@ fn controller(c: &mut Criterion) {
     let capsule = CharacterCapsule::with_height(1.7, 0.28);
     let s = ControllerSettings::default();
     let dt = 1.0 / 60.0;
-    let centre_y = capsule.half_total_height() + s.skin;
-    // Walking at 1.4 m/s with one frame of gravity.
-    let walk = Vec3::new(0.0, -9.81 * dt * dt, 1.4 * dt);
     let mut g = c.benchmark_group("move_shape_1000_colliders");
-    let flat = Transform::from_translation(Vec3::new(0.0, centre_y, 1.0));
-    g.bench_function("walk_flat", |b| {
-        b.iter(|| {
-            black_box(
-                s.move_shape(&level, &capsule, black_box(&flat), walk, dt)
-                    .unwrap(),
-            )
-        })
-    });
-    // Touching the wall at x = 1.2 (its near face), walking at 45° into it.
-    let at_wall = Transform::from_translation(Vec3::new(1.2 - 0.28 - s.skin, centre_y, 25.0));
-    let diagonal = Vec3::new(1.0, 0.0, 1.0).normalize() * 1.4 * dt + Vec3::new(0.0, walk.y, 0.0);
-    g.bench_function("walk_into_wall", |b| {
-        b.iter(|| {
-            black_box(
-                s.move_shape(&level, &capsule, black_box(&at_wall), diagonal, dt)
-                    .unwrap(),
-            )
-        })
-    });
-    // The pose from which the next walking move climbs the first riser of the demo
-    // stairs: found by walking up to it (a fixed guess missed the edge and timed a plain
-    // walk), and asserted here, in the set-up, so that release builds check it too.
-    let mut pose = Transform::from_translation(Vec3::new(0.0, centre_y, STAIRS.3 - 0.6));
-    let before_step = loop {
-        let m = s.move_shape(&level, &capsule, &pose, walk, dt).unwrap();
-        if m.stepped {
-            break pose;
+    // The pose of the stair case is found by walking up to the riser (a fixed guess
+    // missed the edge and timed a plain walk); asserted here, in the set-up, so that
+    // release builds check it too.
+    for (name, pose, desired) in bench_moves(&level).unwrap() {
+        let m = s.move_shape(&level, &capsule, &pose, desired, dt).unwrap();
+        if name == "walk_up_stairs" {
+            assert!(
+                m.stepped && m.translation.y > 0.0,
+                "the stair case must climb the step: {m:?}"
+            );
         }
-        pose.translation += m.translation;
-        assert!(
-            pose.translation.z < STAIRS.3 + 0.5,
-            "the walk never climbed the first riser"
-        );
-    };
-    let m = s
-        .move_shape(&level, &capsule, &before_step, walk, dt)
-        .unwrap();
-    assert!(
-        m.stepped && m.translation.y > 0.0,
-        "the stair case must climb the step: {m:?}"
-    );
-    g.bench_function("walk_up_stairs", |b| {
-        b.iter(|| {
-            black_box(
-                s.move_shape(&level, &capsule, black_box(&before_step), walk, dt)
-                    .unwrap(),
-            )
-        })
-    });
+        g.bench_function(name, |b| {
+            b.iter(|| {
+                black_box(
+                    s.move_shape(&level, &capsule, black_box(&pose), desired, dt)
+                        .unwrap(),
+                )
+            })
+        });
+    }
     g.finish();
 }
 

@@ -189,6 +189,41 @@ pub fn bench_level(count: usize, seed: u64) -> Vec<LevelCollider> {
     c
 }
 
+/// The controller benchmark's three moves in a level built from [`bench_level`] (or
+/// [`demo_level`]), for the demo's capsule (1.7 m, radius 0.28 m) and default settings,
+/// one 60 Hz frame each with one frame of gravity: `(name, capsule pose, desired)` for a
+/// walk (1.4 m/s) on flat ground, a walk at 45° into the wall (touching its near face),
+/// and a walk that climbs the first stair riser, its pose found by walking up to the
+/// stairs. Errors if that walk never climbs the riser.
+pub fn bench_moves(level: &Level) -> crate::Result<[(&'static str, Transform, Vec3); 3]> {
+    let capsule = CharacterCapsule::with_height(1.7, 0.28);
+    let s = ControllerSettings::default();
+    let dt = 1.0 / 60.0;
+    let centre_y = capsule.half_total_height() + s.skin;
+    let walk = Vec3::new(0.0, -GRAVITY * dt * dt, 1.4 * dt);
+    let flat = Transform::from_translation(Vec3::new(0.0, centre_y, 1.0));
+    let at_wall = Transform::from_translation(Vec3::new(1.2 - 0.28 - s.skin, centre_y, 25.0));
+    let diagonal = Vec3::new(1.0, 0.0, 1.0).normalize() * 1.4 * dt + Vec3::new(0.0, walk.y, 0.0);
+    let mut pose = Transform::from_translation(Vec3::new(0.0, centre_y, STAIRS.3 - 0.6));
+    let before_step = loop {
+        let m = s.move_shape(level, &capsule, &pose, walk, dt)?;
+        if m.stepped {
+            break pose;
+        }
+        pose.translation += m.translation;
+        if pose.translation.z >= STAIRS.3 + 0.5 {
+            return Err(crate::Error::InvalidParameter(
+                "the bench walk never climbed the first stair riser".into(),
+            ));
+        }
+    };
+    Ok([
+        ("walk_flat", flat, walk),
+        ("walk_into_wall", at_wall, diagonal),
+        ("walk_up_stairs", before_step, walk),
+    ])
+}
+
 /// Player input over time: `(start s, speed m/s, heading degrees from +z towards +x,
 /// label)`.
 const INPUT: [(f32, f32, f32, &str); 8] = [

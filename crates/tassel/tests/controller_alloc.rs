@@ -11,7 +11,7 @@
 use glam::{Quat, Vec3};
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicUsize, Ordering};
-use tassel::builtin::level::{bench_level, STAIRS};
+use tassel::builtin::level::{bench_level, bench_moves};
 use tassel::controller::{CharacterCapsule, ControllerSettings, Level, Movement};
 use tassel::Transform;
 
@@ -45,21 +45,8 @@ fn move_shape_into_allocates_nothing_per_call() {
     let s = ControllerSettings::default();
     let dt = 1.0 / 60.0;
     let centre_y = capsule.half_total_height() + s.skin;
-    let walk = Vec3::new(0.0, -9.81 * dt * dt, 1.4 * dt);
-    let flat = Transform::from_translation(Vec3::new(0.0, centre_y, 1.0));
-    let at_wall = Transform::from_translation(Vec3::new(1.2 - 0.28 - s.skin, centre_y, 25.0));
-    let diagonal = Vec3::new(1.0, 0.0, 1.0).normalize() * 1.4 * dt + Vec3::new(0.0, walk.y, 0.0);
-    // The pose from which a walking move climbs the first stair riser.
-    let mut pose = Transform::from_translation(Vec3::new(0.0, centre_y, STAIRS.3 - 0.6));
-    let before_step = loop {
-        let m = s.move_shape(&level, &capsule, &pose, walk, dt).unwrap();
-        if m.stepped {
-            break pose;
-        }
-        pose.translation += m.translation;
-        assert!(pose.translation.z < STAIRS.3 + 0.5);
-    };
-    let cases = [(flat, walk), (at_wall, diagonal), (before_step, walk)];
+    // The criterion bench's moves: flat, into the wall, climbing a riser.
+    let cases = bench_moves(&level).unwrap().map(|(_, p, d)| (p, d));
     let mut out = Movement::default();
     // Warm up: the buffers grow to what these moves need.
     for (p, d) in &cases {

@@ -105,6 +105,51 @@ pub fn read_floats(json: &serde_json::Value, bin: &[u8], a: usize) -> Vec<f32> {
     out
 }
 
+/// The components of accessor `a` (UNSIGNED_SHORT, e.g. JOINTS_0; tightly packed or
+/// strided), read by hand.
+pub fn read_u16s(json: &serde_json::Value, bin: &[u8], a: usize) -> Vec<u16> {
+    let acc = &json["accessors"][a];
+    assert_eq!(
+        acc["componentType"], 5123,
+        "accessor {a} is not UNSIGNED_SHORT"
+    );
+    let comps = match acc["type"].as_str().unwrap() {
+        "SCALAR" => 1,
+        "VEC2" => 2,
+        "VEC3" => 3,
+        "VEC4" => 4,
+        t => panic!("accessor type {t}"),
+    };
+    let count = acc["count"].as_u64().unwrap() as usize;
+    let view = &json["bufferViews"][acc["bufferView"].as_u64().unwrap() as usize];
+    let start = view.get("byteOffset").and_then(|v| v.as_u64()).unwrap_or(0) as usize
+        + acc.get("byteOffset").and_then(|v| v.as_u64()).unwrap_or(0) as usize;
+    let stride = view
+        .get("byteStride")
+        .and_then(|v| v.as_u64())
+        .map(|s| s as usize)
+        .unwrap_or(comps * 2);
+    let mut out = Vec::with_capacity(count * comps);
+    for i in 0..count {
+        for c in 0..comps {
+            let o = start + i * stride + c * 2;
+            out.push(u16::from_le_bytes(bin[o..o + 2].try_into().unwrap()));
+        }
+    }
+    out
+}
+
+/// Runs `cmd` and asserts it succeeded (the message shows its standard error).
+pub fn run_ok(cmd: &mut Command) -> std::process::Output {
+    let out = cmd.output().unwrap();
+    assert!(
+        out.status.success(),
+        "{cmd:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
 /// The raw bytes of accessor `a`'s buffer view range (for byte-for-byte comparisons).
 pub fn accessor_bytes<'a>(json: &serde_json::Value, bin: &'a [u8], a: usize) -> &'a [u8] {
     let acc = &json["accessors"][a];
