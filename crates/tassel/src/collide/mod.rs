@@ -14,7 +14,7 @@ pub use r#box::{box_penetration, push_out_of_box};
 pub use sphere::{push_into_sphere, push_out_of_sphere, sphere_penetration};
 
 use crate::math::Transform;
-use glam::Vec3;
+use glam::{Vec3, Vec4};
 use serde::{Deserialize, Serialize};
 
 /// A collider shape in its own local frame.
@@ -80,6 +80,44 @@ impl Shape {
 /// it must not be taken for one that passed through (1e-4 of the contact distance).
 pub(crate) fn contact_tolerance(limit: f32) -> f32 {
     1e-4 * limit
+}
+
+/// The colliders of a list (by position in it) that may act on a point inside one box
+/// (see [`PlacedCollider::may_touch_box`]); positions from 64 on always may.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct NearSet(u64);
+
+impl NearSet {
+    /// The members of `list` (indices into `bounds`, each a collider's
+    /// [`PlacedCollider::bound_sphere`]) that may touch the box `lo`–`hi` for a point of
+    /// radius `r`: all unless the box is farther from the bounding sphere than `r` plus a
+    /// margin well above the f32 rounding of the narrow phases (1e-4 m and 1e-5 of the
+    /// coordinates' size). A non-finite box, radius or centre may touch.
+    pub(crate) fn of(list: &[usize], bounds: &[Vec4], lo: Vec3, hi: Vec3, r: f32) -> NearSet {
+        if !(lo.is_finite() && hi.is_finite() && r.is_finite()) {
+            return NearSet(u64::MAX);
+        }
+        let scale = lo.abs().max(hi.abs()).max_element() + r;
+        let mut bits = 0u64;
+        for (i, &k) in list.iter().enumerate().take(64) {
+            let b = bounds[k];
+            let (c, bound) = (b.truncate(), b.w);
+            let size = scale.max(c.abs().max_element()) + bound;
+            let reach = bound + r + 1e-4 + 1e-5 * size;
+            let d = (lo - c).max(c - hi).max(Vec3::ZERO);
+            // A collider placed at a non-finite point counts as near.
+            if d.length_squared() <= reach * reach || !c.is_finite() {
+                bits |= 1 << i;
+            }
+        }
+        NearSet(bits)
+    }
+
+    /// Whether the list's member at position `i` may act.
+    #[inline]
+    pub(crate) fn contains(self, i: usize) -> bool {
+        i >= 64 || self.0 & (1 << i) != 0
+    }
 }
 
 /// A shape placed in the solver's space.
@@ -150,6 +188,26 @@ impl PlacedCollider {
         }
     }
 
+    /// False only when [`PlacedCollider::resolve`] provably gives back its input for a
+    /// point of radius `r` at any `p` and `prev` inside the box `lo`–`hi` (so also for any
+    /// step between two such points): the box is farther from the shape's bounding
+    /// sphere than the point's radius plus a margin well above f32 rounding. A broad
+    /// phase: the solvers skip colliders that cannot act and get the same bits. Planes,
+    /// inside limits and non-finite boxes always may touch.
+    #[cfg(test)]
+    pub(crate) fn may_touch_box(&self, lo: Vec3, hi: Vec3, r: f32) -> bool {
+        NearSet::of(&[0], &[self.bound_sphere()], lo, hi, r).contains(0)
+    }
+
+    /// The sphere that holds the shape: centre in `xyz`, radius in `w` (infinite for
+    /// planes and inside limits, which act everywhere). What the broad phase
+    /// ([`NearSet`]) reads; the solvers keep one per collider and step.
+    pub(crate) fn bound_sphere(&self) -> Vec4 {
+        self.transform
+            .translation
+            .extend(self.bounding_radius().unwrap_or(f32::INFINITY))
+    }
+
     /// Radius of a sphere about the origin that holds the shape (`None` for planes and
     /// inside limits, which act everywhere).
     fn bounding_radius(&self) -> Option<f32> {
@@ -170,5 +228,131 @@ impl PlacedCollider {
             self.transform.translation - axis,
             self.transform.translation + axis,
         )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rng::SplitMix64;
+    use glam::Quat;
+
+    /// The broad phase's promise: where `may_touch_box` says no, `resolve` gives back its
+    /// input bit for bit for any point and step start in the box. Checked on boxes placed
+    /// just beyond the margin around every bounded shape, with points on the box's faces
+    /// and corners (the nearest to the shape) and inside it, and steps across it.
+    #[test]
+    fn a_collider_that_cannot_touch_a_box_gives_back_every_point_in_it() {
+        let mut rng = SplitMix64::new(7);
+        let mut u = |lo: f32, hi: f32| rng.range_f32(lo, hi);
+        let (mut far, mut near) = (0, 0);
+        for case in 0..4000 {
+            let shape = match case % 3 {
+                0 => Shape::Sphere {
+                    radius: u(0.0, 0.3),
+                    inside: false,
+                },
+                1 => Shape::Capsule {
+                    radius: u(0.0, 0.2),
+                    length: u(0.0, 0.6),
+                },
+                _ => Shape::Box {
+                    half_extents: Vec3::new(u(0.0, 0.2), u(0.0, 0.2), u(0.0, 0.2)),
+                },
+            };
+            let axis = Vec3::new(u(-1.0, 1.0), u(-1.0, 1.0), u(-1.0, 1.0)).normalize_or(Vec3::Y);
+            let placed = |offset: Vec3| PlacedCollider {
+                shape,
+                transform: Transform::from_translation_rotation(
+                    offset,
+                    Quat::from_axis_angle(axis, case as f32 * 0.37),
+                ),
+            };
+            let centre = Vec3::new(u(-3.0, 3.0), u(-3.0, 3.0), u(-3.0, 3.0));
+            let col = placed(centre);
+            let r = u(0.0, 0.05);
+            // A box whose nearest corner or face lies at a chosen distance from the centre.
+            let dir = Vec3::new(u(-1.0, 1.0), u(-1.0, 1.0), u(-1.0, 1.0)).normalize_or(Vec3::X);
+            let bound = col.bounding_radius().unwrap();
+            let gap = bound + r + u(-0.01, 0.02);
+            let size = Vec3::new(u(0.0, 0.4), u(0.0, 0.4), u(0.0, 0.4));
+            let corner = centre + dir * gap;
+            // Grow the box away from the shape on every axis.
+            let away = dir.signum();
+            let other = corner + away * size;
+            let (lo, hi) = (corner.min(other), corner.max(other));
+            if col.may_touch_box(lo, hi, r) {
+                near += 1;
+                continue;
+            }
+            far += 1;
+            let mut pick = |face: bool| {
+                let mut q = Vec3::new(u(0.0, 1.0), u(0.0, 1.0), u(0.0, 1.0));
+                if face {
+                    // Snap one or more coordinates onto the face nearest the shape.
+                    for k in 0..3 {
+                        if u(0.0, 1.0) < 0.6 {
+                            q[k] = if away[k] > 0.0 { 0.0 } else { 1.0 };
+                        }
+                    }
+                }
+                lo + (hi - lo) * q
+            };
+            for _ in 0..8 {
+                let (p, prev) = (pick(true), pick(true));
+                assert_eq!(col.resolve(p, prev, r), p, "case {case}: {shape:?}");
+                let (p, prev) = (pick(false), pick(true));
+                assert_eq!(col.resolve(p, prev, r), p, "case {case}: {shape:?}");
+                assert_eq!(col.resolve(p, p, r), p, "case {case}: {shape:?}");
+            }
+        }
+        // Both answers were exercised.
+        assert!(far > 1000 && near > 300, "far {far}, near {near}");
+        // Planes and inside limits act everywhere; a non-finite box is never skipped.
+        let plane = PlacedCollider {
+            shape: Shape::Plane,
+            transform: Transform::IDENTITY,
+        };
+        assert!(plane.may_touch_box(Vec3::splat(50.0), Vec3::splat(60.0), 0.0));
+        let sphere = PlacedCollider {
+            shape: Shape::Sphere {
+                radius: 0.1,
+                inside: false,
+            },
+            transform: Transform::IDENTITY,
+        };
+        assert!(!sphere.may_touch_box(Vec3::splat(50.0), Vec3::splat(60.0), 0.0));
+        assert!(sphere.may_touch_box(Vec3::new(f32::NAN, 50.0, 50.0), Vec3::splat(60.0), 0.0));
+        let lost = PlacedCollider {
+            transform: Transform::from_translation(Vec3::new(f32::NAN, 0.0, 0.0)),
+            ..sphere
+        };
+        assert!(lost.may_touch_box(Vec3::splat(50.0), Vec3::splat(60.0), 0.0));
+        // A box touching the inflated sphere is never skipped.
+        assert!(sphere.may_touch_box(Vec3::new(0.12, -1.0, -1.0), Vec3::splat(1.0), 0.03));
+    }
+
+    #[test]
+    fn near_sets_hold_the_colliders_that_may_touch_and_every_one_from_64_on() {
+        let at = |x: f32| PlacedCollider {
+            shape: Shape::Sphere {
+                radius: 0.1,
+                inside: false,
+            },
+            transform: Transform::from_translation(Vec3::new(x, 0.0, 0.0)),
+        };
+        let colliders: Vec<PlacedCollider> = (0..70).map(|i| at(i as f32)).collect();
+        let bounds: Vec<Vec4> = colliders.iter().map(|c| c.bound_sphere()).collect();
+        let list: Vec<usize> = (0..70).rev().collect(); // list position i is collider 69 - i
+        let set = NearSet::of(
+            &list,
+            &bounds,
+            Vec3::new(-0.05, -0.05, -0.05),
+            Vec3::splat(0.05),
+            0.0,
+        );
+        for i in 0..70 {
+            assert_eq!(set.contains(i), i == 69 || i >= 64, "position {i}");
+        }
     }
 }

@@ -3,7 +3,7 @@
 use super::compile::{ChainRig, NONE, VIRTUAL};
 use super::settings::{PlanarAxis, TimeMode};
 use super::step::{step_chain, StepInput};
-use crate::collide::PlacedCollider;
+use crate::collide::{NearSet, PlacedCollider};
 use crate::controller::Level;
 use crate::dynamics::path::CharacterPath;
 use crate::dynamics::world::{push_out, WorldContact};
@@ -11,7 +11,7 @@ use crate::error::{Error, Result};
 use crate::math::{normalize_or, rotation_arc, Transform};
 use crate::rng::SplitMix64;
 use crate::skeleton::Skeleton;
-use glam::{Quat, Vec3};
+use glam::{Quat, Vec3, Vec4};
 
 /// The small per-character state of a [`ChainRig`]: point positions and the previous
 /// frame's inputs. Changes only through [`ChainJob::run`], [`ChainState::reset`] and
@@ -36,6 +36,9 @@ pub struct ChainState {
     colliders: Vec<PlacedCollider>,
     prev_colliders: Vec<PlacedCollider>,
     step_colliders: Vec<PlacedCollider>,
+    /// The bounding spheres of `colliders` and `step_colliders`, for the broad phase.
+    bounds: Vec<Vec4>,
+    step_bounds: Vec<Vec4>,
     prev_component: Transform,
     last_step_component: Vec<Transform>,
     accumulator: Vec<f32>,
@@ -71,6 +74,8 @@ impl ChainState {
             colliders: vec![placed; m],
             prev_colliders: vec![placed; m],
             step_colliders: vec![placed; m],
+            bounds: vec![Vec4::ZERO; m],
+            step_bounds: vec![Vec4::ZERO; m],
             prev_component: Transform::IDENTITY,
             last_step_component: vec![Transform::IDENTITY; c],
             accumulator: vec![0.0; c],
@@ -199,6 +204,9 @@ impl ChainJob<'_> {
             &mut state.normals,
             &mut state.colliders,
         );
+        for (b, c) in state.bounds.iter_mut().zip(&state.colliders) {
+            *b = c.bound_sphere();
+        }
 
         state.path.push(component, dt);
         // One broad-phase query for the whole character; away from all geometry the
@@ -288,6 +296,7 @@ fn reset_chain(rig: &ChainRig, ci: usize, state: &mut ChainState, component: &Tr
             targets: &state.targets,
             normals: &state.normals,
             colliders: &state.colliders,
+            bounds: &state.bounds,
             move_cs: Vec3::ZERO,
             rotate_cs: Quat::IDENTITY,
             gravity_cs: gravity_cs(s, component),
@@ -439,6 +448,7 @@ fn run_chain(
                         targets: &state.targets,
                         normals: &state.normals,
                         colliders: &state.colliders,
+                        bounds: &state.bounds,
                         move_cs,
                         rotate_cs,
                         gravity_cs: gravity_cs(s, component),
@@ -507,9 +517,23 @@ fn run_chain(
             // The interpolated output also respects this frame's colliders.
             let mut x = restore(t + dev);
             let r = rig.radius[p];
-            let collide = |mut x: Vec3| {
-                for &c in &rig.chains[ci].colliders {
-                    x = state.colliders[c].resolve(x, x, r);
+            // Broad phase (as in the step): every pass starts from a point on the sphere of
+            // the bone's length about the parent's output.
+            let list = &rig.chains[ci].colliders;
+            let length = anim.length();
+            let near = NearSet::of(
+                list,
+                &state.bounds,
+                state.out[pp] - length,
+                state.out[pp] + length,
+                r,
+            );
+            let collide = |x0: Vec3| {
+                let mut x = x0;
+                for (i, &c) in list.iter().enumerate() {
+                    if near.contains(i) || x != x0 {
+                        x = state.colliders[c].resolve(x, x, r);
+                    }
                 }
                 if let Some(level) = world {
                     let w = component.transform_point(x);
@@ -567,6 +591,7 @@ fn run_fixed(rig: &ChainRig, ci: usize, state: &mut ChainState, dt: f32, level: 
         }
         for &c in &rig.chains[ci].colliders {
             state.step_colliders[c] = state.prev_colliders[c].lerp(&state.colliders[c], w);
+            state.step_bounds[c] = state.step_colliders[c].bound_sphere();
         }
         let comp_b = state.path.at(w);
         let (move_cs, rotate_cs) = motion_cs(&state.last_step_component[ci], &comp_b);
@@ -583,6 +608,7 @@ fn run_fixed(rig: &ChainRig, ci: usize, state: &mut ChainState, dt: f32, level: 
             targets: &state.step_targets,
             normals: &state.step_normals,
             colliders: &state.step_colliders,
+            bounds: &state.step_bounds,
             move_cs,
             rotate_cs,
             gravity_cs: gravity_cs(s, &comp_b),

@@ -2,7 +2,7 @@
 
 use super::compile::{ChainRig, NONE};
 use super::settings::{ClassicGravity, PlanarAxis};
-use crate::collide::PlacedCollider;
+use crate::collide::{NearSet, PlacedCollider};
 use crate::math::normalize_or;
 use crate::rng::SplitMix64;
 use glam::{Quat, Vec3};
@@ -15,6 +15,8 @@ pub(crate) struct StepInput<'a> {
     pub normals: &'a [Vec3],
     /// All colliders, placed at the end of the step.
     pub colliders: &'a [PlacedCollider],
+    /// Their bounding spheres ([`PlacedCollider::bound_sphere`]), for the broad phase.
+    pub bounds: &'a [glam::Vec4],
     /// The old character origin seen from the new character space.
     pub move_cs: Vec3,
     /// The old character rotation seen from the new character space.
@@ -85,15 +87,34 @@ pub(crate) fn step_chain(
         let k = rig.stiffness[p];
         let pull = if k >= 1.0 {
             1.0
+        } else if exponent == 1.0 {
+            // Fixed steps at the target rate: x^1 is x (powf gives exactly that, slowly).
+            1.0 - (1.0 - k)
         } else {
             1.0 - (1.0 - k).powf(exponent)
         };
         x += (base - x) * pull;
 
         let r = rig.radius[p];
-        let collide = |mut x: Vec3| {
-            for &c in &chain.colliders {
-                x = input.colliders[c].resolve(x, prev[p], r);
+        // Broad phase: every point the colliders see below starts as `x` now or as a point
+        // on the sphere of the bone's length about the parent (`restore`), and every step
+        // starts at `prev[p]`; a collider that cannot touch their box gives any such point
+        // back unchanged, so it is skipped while the point is still the one the pass began
+        // with (once a nearer collider moved it, every later collider is asked).
+        let length = (t[p] - t[pp]).length();
+        let near = NearSet::of(
+            &chain.colliders,
+            input.bounds,
+            prev[p].min(x).min(pos[pp] - length),
+            prev[p].max(x).max(pos[pp] + length),
+            r,
+        );
+        let collide = |x0: Vec3| {
+            let mut x = x0;
+            for (i, &c) in chain.colliders.iter().enumerate() {
+                if near.contains(i) || x != x0 {
+                    x = input.colliders[c].resolve(x, prev[p], r);
+                }
             }
             if let Some(world) = &input.world {
                 x = world.resolve(x, prev[p], r);
@@ -121,7 +142,6 @@ pub(crate) fn step_chain(
 
         // Keep the bone length, then settle collisions against the length a few times;
         // collisions get the last word.
-        let length = anim_dir.length();
         let fallback = normalize_or(anim_dir, Vec3::Y);
         let restore = |x: Vec3| pos[pp] + normalize_or(x - pos[pp], fallback) * length;
         x = restore(x);
