@@ -97,7 +97,12 @@ pub(crate) fn push_triangle(
     let mut q = closest_point_on_triangle(c, p0, p1, p2);
     if e0 != e1 {
         for _ in 0..4 {
-            c = closest_point_on_segment(q, e0, e1);
+            let next = closest_point_on_segment(q, e0, e1);
+            if same_bits(next, c) {
+                // A fixed point: every later round would give these same bits.
+                break;
+            }
+            c = next;
             q = closest_point_on_triangle(c, p0, p1, p2);
         }
     }
@@ -130,4 +135,9 @@ pub(crate) fn push_triangle(
             *v += shift * gain;
         }
     }
+}
+
+/// Whether two vectors are the same bits (unlike `==`, which takes −0 for 0).
+fn same_bits(a: Vec3, b: Vec3) -> bool {
+    a.to_array().map(f32::to_bits) == b.to_array().map(f32::to_bits)
 }
