@@ -91,22 +91,22 @@ impl NearSet {
     /// The members of `list` (indices into `bounds`, each a collider's
     /// [`PlacedCollider::bound_sphere`]) that may touch the box `lo`–`hi` for a point of
     /// radius `r`: all unless the box is farther from the bounding sphere than `r` plus a
-    /// margin well above the f32 rounding of the narrow phases (1e-4 m and 1e-5 of the
-    /// coordinates' size). A non-finite box, radius or centre may touch.
+    /// margin well above the f32 rounding of the narrow phases (1e-4 m, and 1e-5 of the
+    /// size and distance from the origin of the collider and of the box). A non-finite
+    /// box or radius may touch everything.
     pub(crate) fn of(list: &[usize], bounds: &[Vec4], lo: Vec3, hi: Vec3, r: f32) -> NearSet {
         if !(lo.is_finite() && hi.is_finite() && r.is_finite()) {
             return NearSet(u64::MAX);
         }
-        let scale = lo.abs().max(hi.abs()).max_element() + r;
+        // The point's part of the margin.
+        let extra = r + 1e-5 * (lo.abs().max(hi.abs()).max_element() + r);
         let mut bits = 0u64;
-        for (i, &k) in list.iter().enumerate().take(64) {
+        for (i, &k) in list.iter().take(64).enumerate() {
             let b = bounds[k];
-            let (c, bound) = (b.truncate(), b.w);
-            let size = scale.max(c.abs().max_element()) + bound;
-            let reach = bound + r + 1e-4 + 1e-5 * size;
+            let c = b.truncate();
             let d = (lo - c).max(c - hi).max(Vec3::ZERO);
-            // A collider placed at a non-finite point counts as near.
-            if d.length_squared() <= reach * reach || !c.is_finite() {
+            let reach = b.w + extra;
+            if d.length_squared() <= reach * reach {
                 bits |= 1 << i;
             }
         }
@@ -199,13 +199,18 @@ impl PlacedCollider {
         NearSet::of(&[0], &[self.bound_sphere()], lo, hi, r).contains(0)
     }
 
-    /// The sphere that holds the shape: centre in `xyz`, radius in `w` (infinite for
-    /// planes and inside limits, which act everywhere). What the broad phase
-    /// ([`NearSet`]) reads; the solvers keep one per collider and step.
+    /// The broad phase's sphere ([`NearSet`]): the shape's centre in `xyz`; in `w` the
+    /// radius of a sphere about it that holds the shape, plus the collider's part of the
+    /// margin for rounding (1e-4 m and 1e-5 of its size and distance from the origin);
+    /// infinite for planes, inside limits and a non-finite placement, which act
+    /// everywhere. The solvers keep one per collider and step.
     pub(crate) fn bound_sphere(&self) -> Vec4 {
-        self.transform
-            .translation
-            .extend(self.bounding_radius().unwrap_or(f32::INFINITY))
+        let c = self.transform.translation;
+        let w = match self.bounding_radius() {
+            Some(bound) if c.is_finite() => bound + 1e-4 + 1e-5 * (c.abs().max_element() + bound),
+            _ => f32::INFINITY,
+        };
+        c.extend(w)
     }
 
     /// Radius of a sphere about the origin that holds the shape (`None` for planes and

@@ -39,6 +39,10 @@ pub struct ChainState {
     /// The bounding spheres of `colliders` and `step_colliders`, for the broad phase.
     bounds: Vec<Vec4>,
     step_bounds: Vec<Vec4>,
+    /// The share of the frame each `step_colliders` entry was placed at (bits), NaN when
+    /// it is not this frame's: chains stepping at the same times (the usual case: one
+    /// rate for all) place each shared collider once.
+    step_placed_at: Vec<f32>,
     prev_component: Transform,
     last_step_component: Vec<Transform>,
     accumulator: Vec<f32>,
@@ -76,6 +80,7 @@ impl ChainState {
             step_colliders: vec![placed; m],
             bounds: vec![Vec4::ZERO; m],
             step_bounds: vec![Vec4::ZERO; m],
+            step_placed_at: vec![f32::NAN; m],
             prev_component: Transform::IDENTITY,
             last_step_component: vec![Transform::IDENTITY; c],
             accumulator: vec![0.0; c],
@@ -207,6 +212,7 @@ impl ChainJob<'_> {
         for (b, c) in state.bounds.iter_mut().zip(&state.colliders) {
             *b = c.bound_sphere();
         }
+        state.step_placed_at.fill(f32::NAN);
 
         state.path.push(component, dt);
         // One broad-phase query for the whole character; away from all geometry the
@@ -285,6 +291,7 @@ fn reset_chain(rig: &ChainRig, ci: usize, state: &mut ChainState, component: &Tr
         state.prev_normals[p] = state.normals[p];
     }
     state.prev_colliders.copy_from_slice(&state.colliders);
+    state.step_placed_at.fill(f32::NAN);
     state.accumulator[ci] = 0.0;
     state.last_step_component[ci] = *component;
     let s = &rig.chains[ci].settings;
@@ -590,8 +597,11 @@ fn run_fixed(rig: &ChainRig, ci: usize, state: &mut ChainState, dt: f32, level: 
             );
         }
         for &c in &rig.chains[ci].colliders {
-            state.step_colliders[c] = state.prev_colliders[c].lerp(&state.colliders[c], w);
-            state.step_bounds[c] = state.step_colliders[c].bound_sphere();
+            if state.step_placed_at[c].to_bits() != w.to_bits() {
+                state.step_colliders[c] = state.prev_colliders[c].lerp(&state.colliders[c], w);
+                state.step_bounds[c] = state.step_colliders[c].bound_sphere();
+                state.step_placed_at[c] = w;
+            }
         }
         let comp_b = state.path.at(w);
         let (move_cs, rotate_cs) = motion_cs(&state.last_step_component[ci], &comp_b);
