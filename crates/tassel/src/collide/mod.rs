@@ -106,9 +106,8 @@ impl NearSet {
             let c = b.truncate();
             let d = (lo - c).max(c - hi).max(Vec3::ZERO);
             let reach = b.w + extra;
-            if d.length_squared() <= reach * reach {
-                bits |= 1 << i;
-            }
+            // Without a branch: which colliders are near changes from point to point.
+            bits |= u64::from(d.length_squared() <= reach * reach) << i;
         }
         NearSet(bits)
     }
