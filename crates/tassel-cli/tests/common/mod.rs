@@ -76,8 +76,34 @@ pub fn glb_chunks(bytes: &[u8]) -> (serde_json::Value, Vec<u8>) {
 
 /// The float components of accessor `a` (FLOAT, tightly packed or strided), read by hand.
 pub fn read_floats(json: &serde_json::Value, bin: &[u8], a: usize) -> Vec<f32> {
+    read_components(json, bin, a, (5126, "FLOAT"), |b: [u8; 4]| {
+        f32::from_le_bytes(b)
+    })
+}
+
+/// The components of accessor `a` (UNSIGNED_SHORT, e.g. JOINTS_0; tightly packed or
+/// strided), read by hand.
+pub fn read_u16s(json: &serde_json::Value, bin: &[u8], a: usize) -> Vec<u16> {
+    read_components(json, bin, a, (5123, "UNSIGNED_SHORT"), |b: [u8; 2]| {
+        u16::from_le_bytes(b)
+    })
+}
+
+/// The components of accessor `a`, each `N` little-endian bytes of glTF component type
+/// `kind` (code, name), decoded by `decode`; tightly packed or strided.
+fn read_components<T, const N: usize>(
+    json: &serde_json::Value,
+    bin: &[u8],
+    a: usize,
+    kind: (u64, &str),
+    decode: impl Fn([u8; N]) -> T,
+) -> Vec<T> {
     let acc = &json["accessors"][a];
-    assert_eq!(acc["componentType"], 5126, "accessor {a} is not FLOAT");
+    assert_eq!(
+        acc["componentType"], kind.0,
+        "accessor {a} is not {}",
+        kind.1
+    );
     let comps = match acc["type"].as_str().unwrap() {
         "SCALAR" => 1,
         "VEC2" => 2,
@@ -94,46 +120,12 @@ pub fn read_floats(json: &serde_json::Value, bin: &[u8], a: usize) -> Vec<f32> {
         .get("byteStride")
         .and_then(|v| v.as_u64())
         .map(|s| s as usize)
-        .unwrap_or(comps * 4);
+        .unwrap_or(comps * N);
     let mut out = Vec::with_capacity(count * comps);
     for i in 0..count {
         for c in 0..comps {
-            let o = start + i * stride + c * 4;
-            out.push(f32::from_le_bytes(bin[o..o + 4].try_into().unwrap()));
-        }
-    }
-    out
-}
-
-/// The components of accessor `a` (UNSIGNED_SHORT, e.g. JOINTS_0; tightly packed or
-/// strided), read by hand.
-pub fn read_u16s(json: &serde_json::Value, bin: &[u8], a: usize) -> Vec<u16> {
-    let acc = &json["accessors"][a];
-    assert_eq!(
-        acc["componentType"], 5123,
-        "accessor {a} is not UNSIGNED_SHORT"
-    );
-    let comps = match acc["type"].as_str().unwrap() {
-        "SCALAR" => 1,
-        "VEC2" => 2,
-        "VEC3" => 3,
-        "VEC4" => 4,
-        t => panic!("accessor type {t}"),
-    };
-    let count = acc["count"].as_u64().unwrap() as usize;
-    let view = &json["bufferViews"][acc["bufferView"].as_u64().unwrap() as usize];
-    let start = view.get("byteOffset").and_then(|v| v.as_u64()).unwrap_or(0) as usize
-        + acc.get("byteOffset").and_then(|v| v.as_u64()).unwrap_or(0) as usize;
-    let stride = view
-        .get("byteStride")
-        .and_then(|v| v.as_u64())
-        .map(|s| s as usize)
-        .unwrap_or(comps * 2);
-    let mut out = Vec::with_capacity(count * comps);
-    for i in 0..count {
-        for c in 0..comps {
-            let o = start + i * stride + c * 2;
-            out.push(u16::from_le_bytes(bin[o..o + 2].try_into().unwrap()));
+            let o = start + i * stride + c * N;
+            out.push(decode(bin[o..o + N].try_into().unwrap()));
         }
     }
     out

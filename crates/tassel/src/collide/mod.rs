@@ -83,7 +83,7 @@ pub(crate) fn contact_tolerance(limit: f32) -> f32 {
 }
 
 /// The colliders of a list (by position in it) that may act on a point inside one box
-/// (see [`PlacedCollider::may_touch_box`]); positions from 64 on always may.
+/// (by their [`PlacedCollider::bound_sphere`]); positions from 64 on always may.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) struct NearSet(u64);
 
@@ -116,6 +116,30 @@ impl NearSet {
     #[inline]
     pub(crate) fn contains(self, i: usize) -> bool {
         i >= 64 || self.0 & (1 << i) != 0
+    }
+
+    /// `x0` resolved against the members of `list` in order, as
+    /// [`PlacedCollider::resolve`] with the step start `prev` (`None`: each collider's
+    /// own input, a point at rest), skipping the colliders outside the set while the
+    /// point is still `x0`. Same bits as asking every collider when `x0` and `prev` lie
+    /// in the set's box: a skipped collider would give such a point back unchanged, and
+    /// once a nearer one moved it (perhaps out of the box) every later one is asked.
+    #[inline]
+    pub(crate) fn resolve(
+        self,
+        list: &[usize],
+        colliders: &[PlacedCollider],
+        x0: Vec3,
+        prev: Option<Vec3>,
+        r: f32,
+    ) -> Vec3 {
+        let mut x = x0;
+        for (i, &c) in list.iter().enumerate() {
+            if self.contains(i) || x != x0 {
+                x = colliders[c].resolve(x, prev.unwrap_or(x), r);
+            }
+        }
+        x
     }
 }
 

@@ -535,13 +535,8 @@ fn run_chain(
                 state.out[pp] + length,
                 r,
             );
-            let collide = |x0: Vec3| {
-                let mut x = x0;
-                for (i, &c) in list.iter().enumerate() {
-                    if near.contains(i) || x != x0 {
-                        x = state.colliders[c].resolve(x, x, r);
-                    }
-                }
+            let collide = |x: Vec3| {
+                let mut x = near.resolve(list, &state.colliders, x, None, r);
                 if let Some(level) = world {
                     let w = component.transform_point(x);
                     let out = push_out(level, w, r);

@@ -109,13 +109,8 @@ pub(crate) fn step_chain(
             prev[p].max(x).max(pos[pp] + length),
             r,
         );
-        let collide = |x0: Vec3| {
-            let mut x = x0;
-            for (i, &c) in chain.colliders.iter().enumerate() {
-                if near.contains(i) || x != x0 {
-                    x = input.colliders[c].resolve(x, prev[p], r);
-                }
-            }
+        let collide = |x: Vec3| {
+            let mut x = near.resolve(&chain.colliders, input.colliders, x, Some(prev[p]), r);
             if let Some(world) = &input.world {
                 x = world.resolve(x, prev[p], r);
             }
