@@ -2,7 +2,8 @@
 
 use std::sync::Arc;
 use std::time::Instant;
-use tassel::crowd::{CrowdPose, VrmCrowd};
+use tassel::crowd::{ChainCrowd, CrowdPose, VrmCrowd};
+use tassel::dynamics::chain::ChainRig;
 use tassel::dynamics::vrm::{VrmMode, VrmOptions, VrmRig};
 use tassel::dynamics::RigSettings;
 use tassel::{builtin, CharacterSim, Transform};
@@ -24,8 +25,8 @@ pub struct Args {
     #[arg(long, conflicts_with = "vrm")]
     cloth: bool,
     /// A crowd of this many characters, each on its own phase of the motion, advanced
-    /// together every frame: VRM springs (any mode) through the crowd path
-    /// (`tassel::crowd`, lane groups of 8), other solvers one `CharacterSim` each.
+    /// together every frame: chains and VRM springs (any mode) through the crowd path
+    /// (`tassel::crowd`, lane groups of 8), the cloth one `CharacterSim` each.
     #[arg(long)]
     crowd: Option<usize>,
     /// Threads sharing the crowd.
@@ -176,14 +177,18 @@ fn crowd(a: &Args, n: usize) -> Result<(), String> {
     }
     let threads = a.threads.min(n);
     let frames = a.frames.max(1);
-    let crowd_path = a.vrm.is_some();
+    let crowd_path = !a.cloth;
     let reference = if !crowd_path || a.compare {
         Some(sims_crowd(a, n, threads, frames)?)
     } else {
         None
     };
     let (what, joints, per_frame, path) = if crowd_path {
-        let (what, joints, t) = vrm_crowd(a, n, threads, frames)?;
+        let (what, joints, t) = if a.vrm.is_some() {
+            vrm_crowd(a, n, threads, frames)?
+        } else {
+            chain_crowd(a, n, threads, frames)?
+        };
         (what, joints, t, "crowd path")
     } else {
         let (what, joints, t) = reference.clone().expect("timed above");
@@ -209,6 +214,61 @@ fn crowd(a: &Args, n: usize) -> Result<(), String> {
     Ok(())
 }
 
+/// The chain crowd path: seconds per frame (median), with what was run.
+fn chain_crowd(
+    a: &Args,
+    n: usize,
+    threads: usize,
+    frames: usize,
+) -> Result<(String, usize, f64), String> {
+    let (_, joints, what) = character(a)?;
+    let (sk, settings) = builtin::bench_character(16, 8, 8);
+    let rig = ChainRig::new(&sk, &settings).map_err(|e| e.to_string())?;
+    let rest = sk.rest().to_vec();
+    let mut crowd = ChainCrowd::new(Arc::new(sk), Arc::new(rig)).map_err(|e| e.to_string())?;
+    for _ in 0..n {
+        crowd.add();
+    }
+    time_crowd(a, threads, frames, what, joints, |f| {
+        crowd
+            .frame(1.0 / 60.0, |i| CrowdPose {
+                transform: motion(f, i as f32 * 0.37),
+                locals: &rest,
+            })
+            .map_err(|e| e.to_string())
+    })
+}
+
+/// Times `frame(f)` for frames `f` = 0, 1, ... on a pool of `threads`: seconds per frame
+/// (median over the runs), with what was run.
+fn time_crowd(
+    a: &Args,
+    threads: usize,
+    frames: usize,
+    what: String,
+    joints: usize,
+    mut frame: impl FnMut(usize) -> Result<(), String> + Send,
+) -> Result<(String, usize, f64), String> {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| e.to_string())?;
+    let mut first_frame = 0usize;
+    let one_run = |frames: usize| -> Result<f64, String> {
+        let start = Instant::now();
+        pool.install(|| -> Result<(), String> {
+            for f in first_frame..first_frame + frames {
+                frame(f)?;
+            }
+            Ok(())
+        })?;
+        first_frame += frames;
+        Ok(start.elapsed().as_secs_f64() / frames as f64)
+    };
+    let samples = sorted_samples(a.runs, frames, one_run)?;
+    Ok((what, joints, samples[samples.len() / 2]))
+}
+
 /// The VRM crowd path: seconds per frame (median), with what was run.
 fn vrm_crowd(
     a: &Args,
@@ -225,30 +285,14 @@ fn vrm_crowd(
     for _ in 0..n {
         crowd.add();
     }
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .map_err(|e| e.to_string())?;
-    let dt = 1.0 / 60.0;
-    let mut first_frame = 0usize;
-    let one_run = |frames: usize| -> Result<f64, String> {
-        let start = Instant::now();
-        pool.install(|| -> Result<(), String> {
-            for f in first_frame..first_frame + frames {
-                crowd
-                    .frame(dt, |i| CrowdPose {
-                        transform: motion(f, i as f32 * 0.37),
-                        locals: &rest,
-                    })
-                    .map_err(|e| e.to_string())?;
-            }
-            Ok(())
-        })?;
-        first_frame += frames;
-        Ok(start.elapsed().as_secs_f64() / frames as f64)
-    };
-    let samples = sorted_samples(a.runs, frames, one_run)?;
-    Ok((what, joints, samples[samples.len() / 2]))
+    time_crowd(a, threads, frames, what, joints, |f| {
+        crowd
+            .frame(1.0 / 60.0, |i| CrowdPose {
+                transform: motion(f, i as f32 * 0.37),
+                locals: &rest,
+            })
+            .map_err(|e| e.to_string())
+    })
 }
 
 /// The single-character path for a crowd: one `CharacterSim` per character, threads

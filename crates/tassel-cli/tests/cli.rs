@@ -442,6 +442,11 @@ fn bench_crowd_and_cloth() {
         String::from_utf8_lossy(&out.stderr)
     );
     let stdout = String::from_utf8_lossy(&out.stdout);
+    // Chains go through the chain crowd path.
+    assert!(
+        stdout.lines().next().unwrap().contains("crowd path"),
+        "{stdout}"
+    );
     let last = stdout.lines().last().unwrap();
     assert!(
         last.starts_with("crowd: 3 characters x 112 joints, 2 threads: ")
@@ -449,7 +454,7 @@ fn bench_crowd_and_cloth() {
             && last.ends_with(" ns per joint-step"),
         "{last}"
     );
-    // VRM springs go through the crowd path; --compare times the single-character path
+    // So do VRM springs; --compare times the single-character path
     // in the same run and says the ratio before the last line.
     let out = tassel()
         .args([

@@ -1,12 +1,14 @@
 //! Criterion bench: one 60 Hz frame of 64 bench characters (16 chains × 8 joints as VRM
 //! springs, 8 colliders, spec mode) through the crowd path and, in the same run, through
 //! one `CharacterSim` each (the single-character reference); the crowd path also with AVX2
-//! forbidden. Single thread. Throughput is reported per simulated joint.
+//! forbidden. The same for the bench character's chains (fixed mode, 60 Hz) through
+//! `ChainCrowd`. Single thread. Throughput is reported per simulated joint.
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use std::hint::black_box;
 use std::sync::Arc;
-use tassel::crowd::{CrowdPose, VrmCrowd};
+use tassel::crowd::{ChainCrowd, CrowdPose, VrmCrowd};
+use tassel::dynamics::chain::ChainRig;
 use tassel::dynamics::vrm::{VrmOptions, VrmRig};
 use tassel::dynamics::RigSettings;
 use tassel::{builtin, CharacterSim, Transform};
@@ -69,5 +71,49 @@ fn vrm_crowd(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, vrm_crowd);
+fn chain_crowd(c: &mut Criterion) {
+    let (sk, settings) = builtin::bench_character(16, 8, 8);
+    let rig = Arc::new(ChainRig::new(&sk, &settings).unwrap());
+    let rest = sk.rest().to_vec();
+    let joints = (N * (rig.point_count() - 16)) as u64; // chain roots are not simulated
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap();
+    let mut g = c.benchmark_group("chain_crowd_64");
+    g.throughput(Throughput::Elements(joints));
+    let mut f = 0u32;
+    let mut crowd = ChainCrowd::new(Arc::new(sk.clone()), rig.clone()).unwrap();
+    for _ in 0..N {
+        crowd.add();
+    }
+    g.bench_function("crowd_path", |b| {
+        b.iter(|| {
+            f += 1;
+            pool.install(|| {
+                crowd
+                    .frame(1.0 / 60.0, |i| CrowdPose {
+                        transform: at(f, i),
+                        locals: &rest,
+                    })
+                    .unwrap()
+            });
+            black_box(crowd.point(0, 1));
+        })
+    });
+    let mut sims: Vec<CharacterSim> = (0..N)
+        .map(|_| CharacterSim::new(sk.clone(), &settings).unwrap())
+        .collect();
+    g.bench_function("single_character_path", |b| {
+        b.iter(|| {
+            f += 1;
+            for (i, sim) in sims.iter_mut().enumerate() {
+                black_box(sim.frame(black_box(&rest), at(f, i), 1.0 / 60.0).unwrap());
+            }
+        })
+    });
+    g.finish();
+}
+
+criterion_group!(benches, vrm_crowd, chain_crowd);
 criterion_main!(benches);

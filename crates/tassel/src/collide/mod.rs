@@ -238,7 +238,7 @@ impl PlacedCollider {
 
     /// Radius of a sphere about the origin that holds the shape (`None` for planes and
     /// inside limits, which act everywhere).
-    fn bounding_radius(&self) -> Option<f32> {
+    pub(crate) fn bounding_radius(&self) -> Option<f32> {
         match self.shape {
             Shape::Sphere {
                 radius,

@@ -329,6 +329,22 @@ impl V3 {
         V3::select(ok, self / len2.sqrt(), fallback)
     }
 
+    /// Every component `v` (a vector plus or minus a scalar, as glam's `Vec3 ± f32`).
+    #[inline(always)]
+    pub fn splat_f(v: F) -> V3 {
+        V3 { x: v, y: v, z: v }
+    }
+
+    /// glam's `Vec3::abs`.
+    #[inline(always)]
+    pub fn abs(self) -> V3 {
+        V3 {
+            x: self.x.abs(),
+            y: self.y.abs(),
+            z: self.z.abs(),
+        }
+    }
+
     /// `m ? a : b` per lane.
     #[inline(always)]
     pub fn select(m: M, a: V3, b: V3) -> V3 {
@@ -566,6 +582,30 @@ impl Trs {
     }
 }
 
+/// [`crate::math::rotation_arc`] per lane.
+#[inline(always)]
+pub fn rotation_arc(from: V3, to: V3) -> Q {
+    let a = from.normalize_or(V3::splat(Vec3::Y));
+    let b = to.normalize_or(a);
+    let w = F::splat(1.0) + a.dot(b);
+    let axis = a.any_orthonormal();
+    let c = a.cross(b);
+    let q = Q {
+        x: c.x,
+        y: c.y,
+        z: c.z,
+        w,
+    }
+    .normalize();
+    let half_turn = Q {
+        x: axis.x,
+        y: axis.y,
+        z: axis.z,
+        w: F::splat(0.0),
+    };
+    Q::select(w.lt(F::splat(1e-7)), half_turn, q)
+}
+
 /// [`crate::math::rotation_arc`] per lane from a direction shared by all lanes: `a` is
 /// `normalize_or(from, Y)` and `half_turn` its 180° quaternion, both precomputed with the
 /// scalar code.
@@ -780,6 +820,17 @@ impl Trs {
             s: self.s.lerp(other.s, t),
         }
     }
+}
+
+/// Whether two per-lane vectors differ (as `Vec3 != Vec3`: by value, `-0 == 0`).
+#[inline(always)]
+pub fn differs(a: V3, b: V3) -> M {
+    let mut r = [0u32; LANES];
+    for i in 0..LANES {
+        let ne = a.x.0[i] != b.x.0[i] || a.y.0[i] != b.y.0[i] || a.z.0[i] != b.z.0[i];
+        r[i] = if ne { !0 } else { 0 };
+    }
+    M(r)
 }
 
 /// [`crate::math::closest_point_on_segment`] per lane.

@@ -8,8 +8,12 @@
 //! readable reference and against which the crowd is tested bit for bit.
 //!
 //! - [`VrmCrowd`]: VRM spring bones (`fixed`, `spec` and `three-vrm` modes).
+//! - [`ChainCrowd`]: bone chains (both time modes, every collider shape).
 
+mod chain;
+mod chain_step;
 pub mod lanes;
 mod vrm;
 
+pub use chain::ChainCrowd;
 pub use vrm::{CrowdPose, VrmCrowd};

@@ -7,7 +7,7 @@
 //! tails) is the same for all lanes. Branches that depend on a character's state (a
 //! contact, a fallback, a reset) are computed for every lane and selected per lane.
 
-use super::lanes::{closest_point_on_segment, rotation_arc_from, Trs, F, LANES, M, Q, V3};
+use super::lanes::{closest_point_on_segment, differs, rotation_arc_from, Trs, F, LANES, M, Q, V3};
 use crate::dynamics::path::CharacterPath;
 use crate::dynamics::vrm::{VrmMode, VrmRig, VrmShape};
 use crate::error::{Error, Result};
@@ -840,17 +840,6 @@ fn settle_one(shape: &VrmShape, placed: &Placed, pos: V3, length: F, tail: V3, r
     let moved = V3::select(F::splat(1.0).le(c), straight, turned);
     let unchanged = length.le(zero).or(valid.not()).or(keep);
     V3::select(unchanged, tail, moved)
-}
-
-/// Whether two per-lane vectors differ (as `Vec3 != Vec3`: by value, `-0 == 0`).
-#[inline(always)]
-fn differs(a: V3, b: V3) -> M {
-    let mut r = [0u32; LANES];
-    for i in 0..LANES {
-        let ne = a.x.0[i] != b.x.0[i] || a.y.0[i] != b.y.0[i] || a.z.0[i] != b.z.0[i];
-        r[i] = if ne { !0 } else { 0 };
-    }
-    M(r)
 }
 
 /// The joints a frame (or a step) works on: the character transform, locals, models.

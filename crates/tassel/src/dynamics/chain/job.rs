@@ -238,7 +238,7 @@ impl ChainJob<'_> {
 }
 
 /// Animated targets, planar normals and placed colliders from the animated model pose.
-fn gather_targets(
+pub(crate) fn gather_targets(
     sk: &Skeleton,
     rig: &ChainRig,
     models: &[Transform],
@@ -329,7 +329,7 @@ fn reset_chain(rig: &ChainRig, ci: usize, state: &mut ChainState, component: &Tr
     state.needs_reset[ci] = false;
 }
 
-fn gravity_cs(s: &super::ChainSettings, component: &Transform) -> Vec3 {
+pub(crate) fn gravity_cs(s: &super::ChainSettings, component: &Transform) -> Vec3 {
     if s.gravity_in_world {
         component.rotation.inverse() * s.gravity
     } else {
@@ -337,12 +337,12 @@ fn gravity_cs(s: &super::ChainSettings, component: &Transform) -> Vec3 {
     }
 }
 
-fn wind_cs(s: &super::ChainSettings, component: &Transform) -> Vec3 {
+pub(crate) fn wind_cs(s: &super::ChainSettings, component: &Transform) -> Vec3 {
     component.rotation.inverse() * normalize_or(s.wind.direction, Vec3::ZERO)
 }
 
 /// Character motion from `a` to `b`, as seen from `b`'s space.
-fn motion_cs(a: &Transform, b: &Transform) -> (Vec3, Quat) {
+pub(crate) fn motion_cs(a: &Transform, b: &Transform) -> (Vec3, Quat) {
     let inv = b.rotation.inverse();
     (
         inv * (a.translation - b.translation),
@@ -558,7 +558,7 @@ fn run_chain(
     }
 }
 
-fn slerp_angle(a: Quat, b: Quat) -> f32 {
+pub(crate) fn slerp_angle(a: Quat, b: Quat) -> f32 {
     let d = a.dot(b).abs().min(1.0);
     2.0 * d.acos()
 }
@@ -642,7 +642,7 @@ fn run_fixed(rig: &ChainRig, ci: usize, state: &mut ChainState, dt: f32, level: 
 
 /// Turns each simulated parent toward its simulated children (mean direction), on top of
 /// its animated rotation, and writes the local rotation.
-fn write_back(
+pub(crate) fn write_back(
     sk: &Skeleton,
     rig: &ChainRig,
     targets: &[Vec3],

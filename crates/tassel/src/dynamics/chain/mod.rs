@@ -6,8 +6,8 @@
 //! [`ChainRig`] is compiled once from [`RigSettings`](crate::dynamics::RigSettings) and a
 //! skeleton; [`ChainState`] is the small per-character state; [`ChainJob`] runs one frame.
 
-mod compile;
-mod job;
+pub(crate) mod compile;
+pub(crate) mod job;
 mod settings;
 mod step;
 

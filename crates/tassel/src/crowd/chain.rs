@@ -1,0 +1,1050 @@
+//! [`ChainCrowd`]: the bone-chain frame of [`crate::dynamics::chain::ChainJob`] (both time
+//! modes) for many characters of one rig, [`LANES`] characters per lane group.
+//!
+//! The frame is the chain job's, reorganised for lanes. Per character and in scalar code
+//! (the job's own functions): the input checks, the model pose, the animated targets and
+//! placed colliders, the character's path and motion, the write-back of rotations. Per
+//! lane group: the solver steps and the output pass ([`super::chain_step`]), where a
+//! character's own branches (a reset, a step count, a contact) are lane masks and the
+//! narrow phase asks the scalar colliders for the lanes whose point may touch one.
+
+use super::chain_step::{output_lanes, step_lanes, Bound, LaneStep};
+use super::lanes::{rotation_arc, Trs, F, LANES, M, Q, V3};
+use super::CrowdPose;
+use crate::collide::PlacedCollider;
+use crate::dynamics::chain::compile::ChainRig;
+use crate::dynamics::chain::job::{gather_targets, gravity_cs, motion_cs, slerp_angle, wind_cs};
+use crate::dynamics::chain::{ChainSettings, ClassicGravity, TimeMode};
+use crate::dynamics::path::CharacterPath;
+use crate::error::{Error, Result};
+use crate::math::Transform;
+use crate::pose::{local_to_model_into, LocalToModelJob};
+use crate::rng::SplitMix64;
+use crate::skeleton::Skeleton;
+use glam::{Quat, Vec3};
+use rayon::prelude::*;
+use std::sync::Arc;
+
+/// A lane group: the chain state of up to [`LANES`] characters, one per lane.
+#[derive(Debug, Clone)]
+struct Pack {
+    /// Characters in use (the other lanes are computed, unseen, and never collide).
+    count: usize,
+    // Per point.
+    pos: Vec<V3>,
+    prev: Vec<V3>,
+    dev: Vec<V3>,
+    dev_before: Vec<V3>,
+    out: Vec<V3>,
+    prev_targets: Vec<V3>,
+    prev_normals: Vec<V3>,
+    /// Last frame's placed colliders, lane after lane (`m` per lane).
+    prev_colliders: Vec<PlacedCollider>,
+    // Per chain.
+    last_step_component: Vec<Trs>,
+    accumulator: Vec<F>,
+    dt_old: Vec<F>,
+    rng: Vec<[SplitMix64; LANES]>,
+    needs_reset: Vec<[bool; LANES]>,
+    // Per lane.
+    paths: [CharacterPath; LANES],
+    prev_component: Trs,
+    teleports: [u64; LANES],
+    /// The local rotation each rotator joint got (per rotator).
+    out_rotation: Vec<Q>,
+    /// The first bad input of the last frame (lane, error): the group was not stepped.
+    error: Option<(usize, Error)>,
+}
+
+/// A chain's wind generator for a fresh character (as [`crate::dynamics::chain::ChainState`]).
+fn fresh_rng(rig: &ChainRig, ci: usize) -> SplitMix64 {
+    SplitMix64::new(rig.chains[ci].settings.wind.seed ^ (ci as u64) << 32)
+}
+
+impl Pack {
+    fn new(rig: &ChainRig) -> Pack {
+        let n = rig.point_count();
+        let m = rig.colliders.len();
+        let c = rig.chains.len();
+        let zero = V3::splat(Vec3::ZERO);
+        let y = V3::splat(Vec3::Y);
+        let id = Trs::splat(&Transform::IDENTITY);
+        Pack {
+            count: 0,
+            pos: vec![zero; n],
+            prev: vec![zero; n],
+            dev: vec![zero; n],
+            dev_before: vec![zero; n],
+            out: vec![zero; n],
+            prev_targets: vec![zero; n],
+            prev_normals: vec![y; n],
+            prev_colliders: vec![placeholder(); m * LANES],
+            last_step_component: vec![id; c],
+            accumulator: vec![F::splat(0.0); c],
+            dt_old: vec![F::splat(0.0); c],
+            rng: (0..c).map(|ci| [fresh_rng(rig, ci); LANES]).collect(),
+            needs_reset: vec![[true; LANES]; c],
+            paths: [CharacterPath::default(); LANES],
+            prev_component: id,
+            teleports: [0; LANES],
+            out_rotation: vec![Q::splat(Quat::IDENTITY); rig.rotators.len()],
+            error: None,
+        }
+    }
+
+    /// Lane `l` as a fresh character (the first frame starts it from its pose).
+    fn clear_lane(&mut self, rig: &ChainRig, l: usize) {
+        for (ci, r) in self.rng.iter_mut().enumerate() {
+            r[l] = fresh_rng(rig, ci);
+        }
+        for n in &mut self.needs_reset {
+            n[l] = true;
+        }
+        self.paths[l] = CharacterPath::default();
+        self.prev_component.set(l, &Transform::IDENTITY);
+        self.teleports[l] = 0;
+    }
+}
+
+fn placeholder() -> PlacedCollider {
+    PlacedCollider {
+        shape: crate::collide::Shape::Plane,
+        transform: Transform::IDENTITY,
+    }
+}
+
+/// One character's state, taken out of its lane (to move it to another).
+#[derive(Debug, Clone)]
+struct LaneState {
+    points: [Vec<Vec3>; 7],
+    prev_colliders: Vec<PlacedCollider>,
+    last_step_component: Vec<Transform>,
+    accumulator: Vec<f32>,
+    dt_old: Vec<f32>,
+    rng: Vec<SplitMix64>,
+    needs_reset: Vec<bool>,
+    path: CharacterPath,
+    prev_component: Transform,
+    teleports: u64,
+    out_rotation: Vec<Quat>,
+}
+
+impl Pack {
+    fn point_fields(&mut self) -> [&mut Vec<V3>; 7] {
+        [
+            &mut self.pos,
+            &mut self.prev,
+            &mut self.dev,
+            &mut self.dev_before,
+            &mut self.out,
+            &mut self.prev_targets,
+            &mut self.prev_normals,
+        ]
+    }
+
+    fn lane(&mut self, l: usize) -> LaneState {
+        let m = self.prev_colliders.len() / LANES;
+        LaneState {
+            points: self
+                .point_fields()
+                .map(|f| f.iter().map(|v| v.get(l)).collect()),
+            prev_colliders: self.prev_colliders[l * m..(l + 1) * m].to_vec(),
+            last_step_component: self.last_step_component.iter().map(|t| t.get(l)).collect(),
+            accumulator: self.accumulator.iter().map(|a| a.get(l)).collect(),
+            dt_old: self.dt_old.iter().map(|a| a.get(l)).collect(),
+            rng: self.rng.iter().map(|r| r[l]).collect(),
+            needs_reset: self.needs_reset.iter().map(|r| r[l]).collect(),
+            path: self.paths[l],
+            prev_component: self.prev_component.get(l),
+            teleports: self.teleports[l],
+            out_rotation: self.out_rotation.iter().map(|q| q.get(l)).collect(),
+        }
+    }
+
+    fn set_lane(&mut self, l: usize, s: &LaneState) {
+        for (field, values) in self.point_fields().into_iter().zip(&s.points) {
+            for (d, v) in field.iter_mut().zip(values) {
+                d.set(l, *v);
+            }
+        }
+        let m = self.prev_colliders.len() / LANES;
+        self.prev_colliders[l * m..(l + 1) * m].copy_from_slice(&s.prev_colliders);
+        for (d, t) in self
+            .last_step_component
+            .iter_mut()
+            .zip(&s.last_step_component)
+        {
+            d.set(l, t);
+        }
+        for (d, v) in self.accumulator.iter_mut().zip(&s.accumulator) {
+            d.0[l] = *v;
+        }
+        for (d, v) in self.dt_old.iter_mut().zip(&s.dt_old) {
+            d.0[l] = *v;
+        }
+        for (d, v) in self.rng.iter_mut().zip(&s.rng) {
+            d[l] = *v;
+        }
+        for (d, v) in self.needs_reset.iter_mut().zip(&s.needs_reset) {
+            d[l] = *v;
+        }
+        self.paths[l] = s.path;
+        self.prev_component.set(l, &s.prev_component);
+        self.teleports[l] = s.teleports;
+        for (d, q) in self.out_rotation.iter_mut().zip(&s.out_rotation) {
+            d.set(l, *q);
+        }
+    }
+}
+
+/// One thread's working buffers: a frame's input and a step's interpolated input.
+#[derive(Debug, Clone)]
+struct Scratch {
+    /// Per lane (`n` joints each): the animated locals and models.
+    locals: Vec<Transform>,
+    models: Vec<Transform>,
+    component: Trs,
+    /// This frame's animated targets and planar normals per point, colliders lane after
+    /// lane, and the colliders' broad-phase spheres.
+    targets: Vec<V3>,
+    normals: Vec<V3>,
+    colliders: Vec<PlacedCollider>,
+    bounds: Vec<Bound>,
+    /// A step's: targets, normals, colliders, spheres, and the share of the frame each
+    /// collider (per lane) was placed at (bits; NaN: not this frame's).
+    step_targets: Vec<V3>,
+    step_normals: Vec<V3>,
+    step_colliders: Vec<PlacedCollider>,
+    step_bounds: Vec<Bound>,
+    step_placed_at: Vec<f32>,
+    /// The write-back's model rotations per joint (the rotator joints and their parents).
+    rotations: Vec<Q>,
+    /// One character's targets and normals, for the scalar code.
+    one_targets: Vec<Vec3>,
+    one_normals: Vec<Vec3>,
+}
+
+impl Scratch {
+    fn new(rig: &ChainRig, joints: usize) -> Scratch {
+        let n = rig.point_count();
+        let m = rig.colliders.len();
+        let zero = V3::splat(Vec3::ZERO);
+        Scratch {
+            locals: vec![Transform::IDENTITY; joints * LANES],
+            models: vec![Transform::IDENTITY; joints * LANES],
+            component: Trs::splat(&Transform::IDENTITY),
+            targets: vec![zero; n],
+            normals: vec![V3::splat(Vec3::Y); n],
+            colliders: vec![placeholder(); m * LANES],
+            bounds: vec![Bound::ZERO; m],
+            step_targets: vec![zero; n],
+            step_normals: vec![V3::splat(Vec3::Y); n],
+            step_colliders: vec![placeholder(); m * LANES],
+            step_bounds: vec![Bound::ZERO; m],
+            step_placed_at: vec![f32::NAN; m * LANES],
+            rotations: vec![Q::splat(Quat::IDENTITY); joints],
+            one_targets: vec![Vec3::ZERO; n],
+            one_normals: vec![Vec3::Y; n],
+        }
+    }
+}
+
+/// Many characters with the same bone chains, advanced together.
+///
+/// Every character shares one skeleton and one compiled [`ChainRig`] (behind [`Arc`]) and
+/// has its own state. A frame reads each character's world transform and animated pose
+/// through a closure, steps all characters ([`LANES`] per lane group, the groups spread
+/// over the current rayon pool's threads) and keeps each character's simulated rotations,
+/// which [`ChainCrowd::write_pose`] writes into a pose.
+///
+/// Results are those of [`crate::dynamics::chain::ChainJob`] (and so of a
+/// [`crate::CharacterSim`] with these chains only) on the same input, bit for bit, in
+/// both time modes, and do not depend on the number of threads. The crowd has no level:
+/// chains with `world_collision` collide with their colliders only.
+///
+/// ```
+/// use std::sync::Arc;
+/// use tassel::crowd::{ChainCrowd, CrowdPose};
+/// use tassel::dynamics::chain::ChainRig;
+/// use tassel::{builtin, Transform};
+///
+/// let (skeleton, settings) = builtin::bench_character(4, 5, 2);
+/// let rig = Arc::new(ChainRig::new(&skeleton, &settings)?);
+/// let skeleton = Arc::new(skeleton);
+/// let mut crowd = ChainCrowd::new(skeleton.clone(), rig)?;
+/// for _ in 0..20 {
+///     crowd.add();
+/// }
+/// let rest = skeleton.rest().to_vec();
+/// for frame in 0..10 {
+///     crowd.frame(1.0 / 60.0, |i| CrowdPose {
+///         transform: Transform::from_translation(glam::Vec3::X * (i as f32 + frame as f32 * 0.01)),
+///         locals: &rest,
+///     })?;
+/// }
+/// let mut locals = rest.clone();
+/// let mut models = rest.clone();
+/// crowd.write_pose(3, &mut locals, &mut models)?;
+/// # Ok::<(), tassel::Error>(())
+/// ```
+#[derive(Debug, Clone)]
+pub struct ChainCrowd {
+    skeleton: Arc<Skeleton>,
+    rig: Arc<ChainRig>,
+    packs: Vec<Pack>,
+    len: usize,
+    scratch: Vec<Scratch>,
+    reach: Vec<Option<f32>>,
+    avx2: bool,
+}
+
+impl ChainCrowd {
+    /// An empty crowd of characters with `skeleton` and `rig` (compiled for it).
+    pub fn new(skeleton: Arc<Skeleton>, rig: Arc<ChainRig>) -> Result<Self> {
+        if rig.joint_count() != skeleton.len() {
+            return Err(Error::LengthMismatch {
+                what: "chain rig joints",
+                expected: skeleton.len(),
+                got: rig.joint_count(),
+            });
+        }
+        let reach = rig
+            .colliders
+            .iter()
+            .map(|c| {
+                PlacedCollider {
+                    shape: c.shape,
+                    transform: Transform::IDENTITY,
+                }
+                .bounding_radius()
+            })
+            .collect();
+        Ok(Self {
+            skeleton,
+            rig,
+            packs: Vec::new(),
+            len: 0,
+            scratch: Vec::new(),
+            reach,
+            avx2: true,
+        })
+    }
+
+    /// Adds a character; returns its index. It starts from its pose on its first frame.
+    pub fn add(&mut self) -> usize {
+        if self.len % LANES == 0 {
+            self.packs.push(Pack::new(&self.rig));
+        }
+        let i = self.len;
+        let pack = &mut self.packs[i / LANES];
+        pack.count += 1;
+        pack.clear_lane(&self.rig, i % LANES);
+        self.len += 1;
+        i
+    }
+
+    /// Removes character `i`; the last character takes its index (as `Vec::swap_remove`),
+    /// and carries on exactly as it would have.
+    pub fn swap_remove(&mut self, i: usize) -> Result<()> {
+        self.check(i)?;
+        let last = self.len - 1;
+        if i != last {
+            let moved = self.packs[last / LANES].lane(last % LANES);
+            self.packs[i / LANES].set_lane(i % LANES, &moved);
+        }
+        let pack = &mut self.packs[last / LANES];
+        pack.count -= 1;
+        if pack.count == 0 {
+            self.packs.pop();
+        }
+        self.len -= 1;
+        Ok(())
+    }
+
+    /// Allows (the default) or forbids the AVX2 code path on CPUs that have it. The results
+    /// are the same bits either way; forbidding it is for measuring and testing the
+    /// baseline (SSE2) path.
+    pub fn set_avx2(&mut self, allow: bool) {
+        self.avx2 = allow;
+    }
+
+    /// Number of characters.
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    /// True when there is no character.
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// The shared skeleton.
+    pub fn skeleton(&self) -> &Arc<Skeleton> {
+        &self.skeleton
+    }
+
+    /// The shared rig.
+    pub fn rig(&self) -> &Arc<ChainRig> {
+        &self.rig
+    }
+
+    fn check(&self, i: usize) -> Result<()> {
+        if i < self.len {
+            Ok(())
+        } else {
+            Err(Error::InvalidParameter(format!(
+                "crowd character {i} does not exist (the crowd has {})",
+                self.len
+            )))
+        }
+    }
+
+    /// Makes character `i` start again from its pose on the next frame.
+    pub fn reset(&mut self, i: usize) -> Result<()> {
+        self.check(i)?;
+        for n in &mut self.packs[i / LANES].needs_reset {
+            n[i % LANES] = true;
+        }
+        Ok(())
+    }
+
+    /// Character `i` was moved on purpose: it starts again instead of swinging.
+    pub fn teleport(&mut self, i: usize) -> Result<()> {
+        self.reset(i)
+    }
+
+    /// How many chain resets a teleport (or a non-finite result) caused for character `i`
+    /// (as [`crate::dynamics::chain::ChainState::teleport_count`]).
+    pub fn teleport_count(&self, i: usize) -> Option<u64> {
+        (i < self.len).then(|| self.packs[i / LANES].teleports[i % LANES])
+    }
+
+    /// Character `i`'s simulated position of point `point` after the last frame (model
+    /// space, as [`crate::dynamics::chain::ChainState::output_positions`]).
+    pub fn point(&self, i: usize, point: usize) -> Option<Vec3> {
+        if i >= self.len || point >= self.rig.point_count() {
+            return None;
+        }
+        Some(self.packs[i / LANES].out[point].get(i % LANES))
+    }
+
+    /// Character `i`'s pose after the last frame: `locals` holds its animated pose of that
+    /// frame on entry; the chains' rotations are written into it, and `models` receives
+    /// the model pose. Never allocates.
+    pub fn write_pose(
+        &self,
+        i: usize,
+        locals: &mut [Transform],
+        models: &mut [Transform],
+    ) -> Result<()> {
+        self.check(i)?;
+        let n = self.skeleton.len();
+        if locals.len() != n {
+            return Err(Error::LengthMismatch {
+                what: "locals",
+                expected: n,
+                got: locals.len(),
+            });
+        }
+        let pack = &self.packs[i / LANES];
+        for (k, (joint, _, _)) in self.rig.rotators.iter().enumerate() {
+            locals[*joint as usize].rotation = pack.out_rotation[k].get(i % LANES);
+        }
+        LocalToModelJob {
+            skeleton: &self.skeleton,
+            root: Transform::IDENTITY,
+            locals,
+            models,
+        }
+        .run()
+    }
+
+    /// Advances every character by `dt` seconds (finite, ≥ 0). `input(i)` gives character
+    /// `i`'s world transform and animated pose; it is called once per character, from
+    /// the rayon pool's threads.
+    ///
+    /// A character whose input is bad (wrong length, not finite, beyond the limits) makes
+    /// the frame return an error naming it; the [`LANES`] characters of its lane group
+    /// are not stepped this frame, every other character is. Never allocates once each
+    /// thread has run a frame.
+    pub fn frame<'a, I>(&mut self, dt: f32, input: I) -> Result<()>
+    where
+        I: Fn(usize) -> CrowdPose<'a> + Sync,
+    {
+        if !(dt.is_finite() && dt >= 0.0) {
+            return Err(Error::InvalidTimeStep(dt));
+        }
+        if self.packs.is_empty() {
+            return Ok(());
+        }
+        let threads = rayon::current_num_threads().max(1);
+        let chunk = self.packs.len().div_ceil(threads);
+        let chunks = self.packs.len().div_ceil(chunk);
+        while self.scratch.len() < chunks {
+            self.scratch
+                .push(Scratch::new(&self.rig, self.skeleton.len()));
+        }
+        let ctx = Ctx {
+            sk: &self.skeleton,
+            rig: &self.rig,
+            reach: &self.reach,
+            dt,
+            avx2: self.avx2,
+        };
+        let input = &input;
+        self.packs
+            .par_chunks_mut(chunk)
+            .zip(self.scratch[..chunks].par_iter_mut())
+            .enumerate()
+            .for_each(|(c, (packs, scratch))| {
+                for (k, pack) in packs.iter_mut().enumerate() {
+                    let base = (c * chunk + k) * LANES;
+                    pack.error = ctx.gather(pack, scratch, base, input).err();
+                    if pack.error.is_none() {
+                        ctx.step(pack, scratch);
+                    }
+                }
+            });
+        match self.packs.iter().find_map(|p| p.error.clone()) {
+            Some((_, e)) => Err(e),
+            None => Ok(()),
+        }
+    }
+}
+
+/// What every lane group's frame reads.
+struct Ctx<'c> {
+    sk: &'c Skeleton,
+    rig: &'c ChainRig,
+    /// Each collider's bounding radius (`None`: it acts everywhere).
+    reach: &'c [Option<f32>],
+    dt: f32,
+    avx2: bool,
+}
+
+/// Gravity's share of one step of `dt` (the chain step's formula for the time mode).
+fn gravity_step(s: &ChainSettings, g: Vec3, dt: f32, fixed: bool) -> Vec3 {
+    match (fixed, s.classic_gravity) {
+        (true, _) | (false, ClassicGravity::DtSquared) => g * dt * dt,
+        (false, ClassicGravity::PerFrame) => g * dt,
+        (false, ClassicGravity::HalfDtSquared) => g * (0.5 * dt * dt),
+    }
+}
+
+/// The per-lane inputs of a step that depend on where each character is: its motion since
+/// `from` (none when `from` is `None`), gravity's share and the wind, for the `active`
+/// lanes.
+struct Motion {
+    move_cs: V3,
+    rotate_cs: Q,
+    gravity_step: V3,
+    wind_cs: V3,
+    wind_on: M,
+}
+
+fn motion(
+    s: &ChainSettings,
+    from: Option<&Trs>,
+    to: &Trs,
+    dt: f32,
+    fixed: bool,
+    active: M,
+) -> Motion {
+    let mut out = Motion {
+        move_cs: V3::splat(Vec3::ZERO),
+        rotate_cs: Q::splat(Quat::IDENTITY),
+        gravity_step: V3::splat(Vec3::ZERO),
+        wind_cs: V3::splat(Vec3::ZERO),
+        wind_on: M::NONE,
+    };
+    let mut wind = [false; LANES];
+    for (l, wind) in wind.iter_mut().enumerate() {
+        if active.0[l] == 0 {
+            continue;
+        }
+        let b = to.get(l);
+        if let Some(a) = from {
+            let (m, r) = motion_cs(&a.get(l), &b);
+            out.move_cs.set(l, m);
+            out.rotate_cs.set(l, r);
+        }
+        out.gravity_step
+            .set(l, gravity_step(s, gravity_cs(s, &b), dt, fixed));
+        let w = wind_cs(s, &b);
+        out.wind_cs.set(l, w);
+        *wind = s.wind.speed > 0.0 && w != Vec3::ZERO;
+    }
+    out.wind_on = M::from_bools(wind);
+    out
+}
+
+impl Ctx<'_> {
+    /// Checks the group's input and computes its animated targets and colliders into
+    /// `scratch`. Touches no state.
+    fn gather<'a, I>(
+        &self,
+        pack: &Pack,
+        scratch: &mut Scratch,
+        base: usize,
+        input: &I,
+    ) -> std::result::Result<(), (usize, Error)>
+    where
+        I: Fn(usize) -> CrowdPose<'a> + Sync,
+    {
+        let (sk, rig) = (self.sk, self.rig);
+        let n = sk.len();
+        let m = rig.colliders.len();
+        for lane in 0..pack.count {
+            let i = base + lane;
+            let pose = input(i);
+            if pose.locals.len() != n {
+                return Err((
+                    lane,
+                    Error::LengthMismatch {
+                        what: "crowd character's animated pose",
+                        expected: n,
+                        got: pose.locals.len(),
+                    },
+                ));
+            }
+            if let Some(j) = pose.locals.iter().position(|t| !t.within_limits()) {
+                return Err((
+                    lane,
+                    Error::NonFinite(format!(
+                        "crowd character {i}: animated pose of joint '{}' is not finite, not a \
+                         unit rotation, or lies beyond {:e}",
+                        sk.name(j),
+                        crate::limits::MAX_COORDINATE
+                    )),
+                ));
+            }
+            if !pose.transform.within_limits() {
+                return Err((
+                    lane,
+                    Error::NonFinite(format!(
+                        "crowd character {i}: transform is not finite or lies beyond {:e}",
+                        crate::limits::MAX_COORDINATE
+                    )),
+                ));
+            }
+            scratch.component.set(lane, &pose.transform);
+            let locals = &mut scratch.locals[lane * n..(lane + 1) * n];
+            let models = &mut scratch.models[lane * n..(lane + 1) * n];
+            locals.copy_from_slice(pose.locals);
+            local_to_model_into(sk, locals, models);
+            if let Some(j) = models.iter().position(|t| !t.is_finite()) {
+                return Err((
+                    lane,
+                    Error::NonFinite(format!(
+                        "crowd character {i}: animated pose of joint '{}'",
+                        sk.name(j)
+                    )),
+                ));
+            }
+            let colliders = &mut scratch.colliders[lane * m..(lane + 1) * m];
+            gather_targets(
+                sk,
+                rig,
+                models,
+                &mut scratch.one_targets,
+                &mut scratch.one_normals,
+                colliders,
+            );
+            for (d, v) in scratch.targets.iter_mut().zip(&scratch.one_targets) {
+                d.set(lane, *v);
+            }
+            for (d, v) in scratch.normals.iter_mut().zip(&scratch.one_normals) {
+                d.set(lane, *v);
+            }
+            for (b, c) in scratch.bounds.iter_mut().zip(colliders.iter()) {
+                let s = c.bound_sphere();
+                b.c.set(lane, s.truncate());
+                b.w.0[lane] = s.w;
+            }
+        }
+        Ok(())
+    }
+
+    /// One frame of one lane group whose input is in `s`: with AVX2 where the CPU has it,
+    /// else with the baseline SSE2. Both compile the same code, whose every operation is
+    /// IEEE-exact per lane, so both give the same bits.
+    fn step(&self, pack: &mut Pack, s: &mut Scratch) {
+        #[cfg(target_arch = "x86_64")]
+        if self.avx2 && std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: `step_avx2` only requires the AVX2 instructions, and the CPU was
+            // just checked to have them.
+            #[allow(unsafe_code)]
+            unsafe {
+                return self.step_avx2(pack, s);
+            }
+        }
+        self.step_lanes(pack, s)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn step_avx2(&self, pack: &mut Pack, s: &mut Scratch) {
+        self.step_lanes(pack, s)
+    }
+
+    /// One frame of one lane group whose input is in `scratch`.
+    #[inline(always)]
+    fn step_lanes(&self, pack: &mut Pack, s: &mut Scratch) {
+        let rig = self.rig;
+        let live = M::from_bools(std::array::from_fn(|l| l < pack.count));
+        for l in 0..pack.count {
+            pack.paths[l].push(s.component.get(l), self.dt);
+        }
+        s.step_placed_at.fill(f32::NAN);
+        for ci in 0..rig.chains.len() {
+            self.run_chain(ci, pack, s, live);
+        }
+        pack.prev_targets.copy_from_slice(&s.targets);
+        pack.prev_normals.copy_from_slice(&s.normals);
+        pack.prev_colliders.copy_from_slice(&s.colliders);
+        pack.prev_component = s.component;
+        self.write_back(pack, s);
+    }
+
+    /// The chain job's `write_back` per lane: each rotator joint turned toward its
+    /// simulated children (mean direction) on top of its animated rotation; its local
+    /// rotation is kept per lane.
+    #[inline(always)]
+    fn write_back(&self, pack: &mut Pack, s: &mut Scratch) {
+        let (sk, rig) = (self.sk, self.rig);
+        let n = sk.len();
+        for &(j, _, _) in &rig.rotators {
+            let j = j as usize;
+            for k in std::iter::once(j).chain(sk.parent(j)) {
+                for l in 0..pack.count {
+                    s.rotations[k].set(l, s.models[l * n + k].rotation);
+                }
+            }
+        }
+        let zero = V3::splat(Vec3::ZERO);
+        let tiny = F::splat(1e-12);
+        for (k, (joint, point, kids)) in rig.rotators.iter().enumerate() {
+            let (j, p) = (*joint as usize, *point as usize);
+            let (mut anim, mut sim) = (zero, zero);
+            for &c in &rig.rotator_children[kids.start as usize..kids.end as usize] {
+                let c = c as usize;
+                anim = anim + (s.targets[c] - s.targets[p]).normalize_or(zero);
+                sim = sim + (pack.out[c] - pack.out[p]).normalize_or(zero);
+            }
+            let skip = anim.dot(anim).lt(tiny).or(sim.dot(sim).lt(tiny));
+            let new_rot = rotation_arc(anim, sim).mul_quat(s.rotations[j]).normalize();
+            let parent_rot = match sk.parent(j) {
+                Some(q) => s.rotations[q],
+                None => Q::splat(Quat::IDENTITY),
+            };
+            let local = parent_rot.conjugate().mul_quat(new_rot).normalize();
+            let mut animated = Q::splat(Quat::IDENTITY);
+            for l in 0..pack.count {
+                animated.set(l, s.locals[l * n + j].rotation);
+            }
+            pack.out_rotation[k] = Q::select(skip, animated, local);
+            s.rotations[j] = Q::select(skip, s.rotations[j], new_rot);
+        }
+    }
+
+    #[inline(always)]
+    fn run_chain(&self, ci: usize, pack: &mut Pack, s: &mut Scratch, live: M) {
+        let rig = self.rig;
+        let set = &rig.chains[ci].settings;
+        let points = rig.chains[ci].points.clone();
+        // Teleport detection on each character's own motion this frame.
+        for l in 0..pack.count {
+            if pack.needs_reset[ci][l] {
+                continue;
+            }
+            let (a, b) = (pack.prev_component.get(l), s.component.get(l));
+            let moved = (b.translation - a.translation).length();
+            let turned = slerp_angle(a.rotation, b.rotation).to_degrees();
+            if (set.teleport_distance > 0.0 && moved > set.teleport_distance)
+                || (set.teleport_rotation > 0.0 && turned > set.teleport_rotation)
+            {
+                pack.needs_reset[ci][l] = true;
+                pack.teleports[l] += 1;
+            }
+        }
+        let reset = M::from_bools(pack.needs_reset[ci]).and(live);
+        if reset.any() {
+            self.reset_chain(ci, pack, s, reset);
+        }
+        let run = live.and(reset.not());
+        if run.any() {
+            match set.mode {
+                TimeMode::Classic => self.run_classic(ci, pack, s, run),
+                TimeMode::Fixed => self.run_fixed(ci, pack, s, run),
+            }
+        }
+        // Guard: never let a non-finite value out; start again from the pose instead.
+        let mut bad = M::NONE;
+        for p in points.clone() {
+            bad = bad.or(pack.pos[p].finite().not());
+        }
+        let bad = bad.and(live);
+        if bad.any() {
+            for l in 0..LANES {
+                if bad.0[l] != 0 {
+                    pack.teleports[l] += 1;
+                }
+            }
+            self.reset_chain(ci, pack, s, bad);
+        }
+        let w = match set.mode {
+            TimeMode::Fixed => {
+                (pack.accumulator[ci] / F::splat(1.0 / set.target_framerate)).clamp01()
+            }
+            TimeMode::Classic => F::splat(1.0),
+        };
+        output_lanes(
+            rig,
+            ci,
+            w,
+            &s.targets,
+            &pack.dev_before,
+            &pack.dev,
+            &s.colliders,
+            &s.bounds,
+            self.reach,
+            &mut pack.out,
+            live,
+        );
+    }
+
+    /// The chain job's `reset_chain` for the lanes `m`.
+    #[inline(always)]
+    fn reset_chain(&self, ci: usize, pack: &mut Pack, s: &mut Scratch, m: M) {
+        let rig = self.rig;
+        let set = &rig.chains[ci].settings;
+        let points = rig.chains[ci].points.clone();
+        let zero = V3::splat(Vec3::ZERO);
+        for p in points.clone() {
+            let t = s.targets[p];
+            pack.pos[p] = V3::select(m, t, pack.pos[p]);
+            pack.prev[p] = V3::select(m, t, pack.prev[p]);
+            pack.dev[p] = V3::select(m, zero, pack.dev[p]);
+            pack.dev_before[p] = V3::select(m, zero, pack.dev_before[p]);
+            pack.prev_targets[p] = V3::select(m, t, pack.prev_targets[p]);
+            pack.prev_normals[p] = V3::select(m, s.normals[p], pack.prev_normals[p]);
+        }
+        let k = rig.colliders.len();
+        for l in 0..LANES {
+            if m.0[l] != 0 {
+                let lane = l * k..(l + 1) * k;
+                pack.prev_colliders[lane.clone()].copy_from_slice(&s.colliders[lane.clone()]);
+                s.step_placed_at[lane].fill(f32::NAN);
+            }
+        }
+        pack.accumulator[ci] = F::select(m, F::splat(0.0), pack.accumulator[ci]);
+        pack.last_step_component[ci] = Trs::select(m, &s.component, &pack.last_step_component[ci]);
+        let h = 1.0 / set.target_framerate;
+        pack.dt_old[ci] = F::select(m, F::splat(h), pack.dt_old[ci]);
+        // Warm-up: settle in place with the current targets and no character motion.
+        let fixed = set.mode == TimeMode::Fixed;
+        if set.warmup_steps > 0 {
+            let mo = motion(set, None, &s.component, h, fixed, m);
+            for _ in 0..set.warmup_steps {
+                let input = LaneStep {
+                    targets: &s.targets,
+                    normals: &s.normals,
+                    colliders: &s.colliders,
+                    bounds: &s.bounds,
+                    reach: self.reach,
+                    move_cs: mo.move_cs,
+                    rotate_cs: mo.rotate_cs,
+                    gravity_step: mo.gravity_step,
+                    wind_cs: mo.wind_cs,
+                    wind_on: mo.wind_on,
+                    dt: h,
+                    dt_old: F::splat(h),
+                    active: m,
+                };
+                step_lanes(
+                    rig,
+                    ci,
+                    &input,
+                    &mut pack.pos,
+                    &mut pack.prev,
+                    &mut pack.rng[ci],
+                );
+            }
+        }
+        for p in points {
+            let d = pack.pos[p] - s.targets[p];
+            pack.dev[p] = V3::select(m, d, pack.dev[p]);
+            pack.dev_before[p] = V3::select(m, d, pack.dev_before[p]);
+        }
+        for l in 0..LANES {
+            if m.0[l] != 0 {
+                pack.needs_reset[ci][l] = false;
+            }
+        }
+    }
+
+    #[inline(always)]
+    fn run_classic(&self, ci: usize, pack: &mut Pack, s: &mut Scratch, run: M) {
+        let rig = self.rig;
+        let set = &rig.chains[ci].settings;
+        let dt = self.dt.min(set.max_delta_time);
+        if dt > 0.0 {
+            let mo = motion(
+                set,
+                Some(&pack.prev_component),
+                &s.component,
+                dt,
+                false,
+                run,
+            );
+            let input = LaneStep {
+                targets: &s.targets,
+                normals: &s.normals,
+                colliders: &s.colliders,
+                bounds: &s.bounds,
+                reach: self.reach,
+                move_cs: mo.move_cs,
+                rotate_cs: mo.rotate_cs,
+                gravity_step: mo.gravity_step,
+                wind_cs: mo.wind_cs,
+                wind_on: mo.wind_on,
+                dt,
+                dt_old: pack.dt_old[ci],
+                active: run,
+            };
+            step_lanes(
+                rig,
+                ci,
+                &input,
+                &mut pack.pos,
+                &mut pack.prev,
+                &mut pack.rng[ci],
+            );
+            pack.dt_old[ci] = F::select(run, F::splat(dt), pack.dt_old[ci]);
+        }
+        for p in rig.chains[ci].points.clone() {
+            let d = pack.pos[p] - s.targets[p];
+            pack.dev[p] = V3::select(run, d, pack.dev[p]);
+            pack.dev_before[p] = V3::select(run, d, pack.dev_before[p]);
+        }
+    }
+
+    #[inline(always)]
+    fn run_fixed(&self, ci: usize, pack: &mut Pack, s: &mut Scratch, run: M) {
+        let rig = self.rig;
+        let chain = &rig.chains[ci];
+        let set = &chain.settings;
+        let dt = self.dt;
+        let h = 1.0 / set.target_framerate;
+        let k_all = rig.colliders.len();
+        // Each lane's step count and skipped time, as the job's `run_fixed`.
+        let acc_old = pack.accumulator[ci];
+        let mut total = [0.0f32; LANES];
+        let mut steps = [0u32; LANES];
+        let mut skipped = [0.0f32; LANES];
+        let mut most = 0;
+        for l in 0..LANES {
+            if run.0[l] == 0 {
+                continue;
+            }
+            let a = acc_old.0[l];
+            total[l] = a + dt;
+            steps[l] = (total[l] / h + 1e-4).floor() as u32;
+            if steps[l] > set.max_steps_per_frame {
+                total[l] -= (steps[l] - set.max_steps_per_frame) as f32 * h;
+                steps[l] = set.max_steps_per_frame;
+            }
+            skipped[l] = a + dt - total[l];
+            most = most.max(steps[l]);
+        }
+        for k in 1..=most {
+            let active = M::from_bools(std::array::from_fn(|l| run.0[l] != 0 && k <= steps[l]));
+            let w = F(std::array::from_fn(|l| {
+                let end = k as f32 * h - acc_old.0[l] + skipped[l];
+                if dt > 0.0 {
+                    (end / dt).clamp(0.0, 1.0)
+                } else {
+                    1.0
+                }
+            }));
+            for p in chain.points.clone() {
+                s.step_targets[p] = s.prev_targets_lerp(pack, p, w);
+                s.step_normals[p] = pack.prev_normals[p]
+                    .lerp(s.normals[p], w)
+                    .normalize_or(s.normals[p]);
+            }
+            for &c in &chain.colliders {
+                for l in 0..LANES {
+                    let at = l * k_all + c;
+                    if active.0[l] != 0 && s.step_placed_at[at].to_bits() != w.0[l].to_bits() {
+                        s.step_colliders[at] =
+                            pack.prev_colliders[at].lerp(&s.colliders[at], w.0[l]);
+                        let b = s.step_colliders[at].bound_sphere();
+                        s.step_bounds[c].c.set(l, b.truncate());
+                        s.step_bounds[c].w.0[l] = b.w;
+                        s.step_placed_at[at] = w.0[l];
+                    }
+                }
+            }
+            let mut comp_b = Trs::splat(&Transform::IDENTITY);
+            for l in 0..LANES {
+                if active.0[l] != 0 {
+                    comp_b.set(l, &pack.paths[l].at(w.0[l]));
+                }
+            }
+            let mo = motion(
+                set,
+                Some(&pack.last_step_component[ci]),
+                &comp_b,
+                h,
+                true,
+                active,
+            );
+            let input = LaneStep {
+                targets: &s.step_targets,
+                normals: &s.step_normals,
+                colliders: &s.step_colliders,
+                bounds: &s.step_bounds,
+                reach: self.reach,
+                move_cs: mo.move_cs,
+                rotate_cs: mo.rotate_cs,
+                gravity_step: mo.gravity_step,
+                wind_cs: mo.wind_cs,
+                wind_on: mo.wind_on,
+                dt: h,
+                dt_old: F::splat(h),
+                active,
+            };
+            step_lanes(
+                rig,
+                ci,
+                &input,
+                &mut pack.pos,
+                &mut pack.prev,
+                &mut pack.rng[ci],
+            );
+            pack.last_step_component[ci] =
+                Trs::select(active, &comp_b, &pack.last_step_component[ci]);
+            for p in chain.points.clone() {
+                let d = pack.pos[p] - s.step_targets[p];
+                pack.dev_before[p] = V3::select(active, pack.dev[p], pack.dev_before[p]);
+                pack.dev[p] = V3::select(active, d, pack.dev[p]);
+            }
+        }
+        let mut acc = pack.accumulator[ci];
+        for l in 0..LANES {
+            if run.0[l] != 0 {
+                acc.0[l] = (total[l] - steps[l] as f32 * h).max(0.0);
+            }
+        }
+        pack.accumulator[ci] = acc;
+    }
+}
+
+impl Scratch {
+    /// A step's target of point `p`: last frame's and this frame's, interpolated by `w`.
+    #[inline(always)]
+    fn prev_targets_lerp(&self, pack: &Pack, p: usize, w: F) -> V3 {
+        pack.prev_targets[p].lerp(self.targets[p], w)
+    }
+}

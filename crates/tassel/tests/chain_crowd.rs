@@ -1,0 +1,429 @@
+//! The chain crowd path against the single-character path (`CharacterSim` with the same
+//! chains): the same bits, frame after frame, for every character, whatever the thread
+//! count.
+
+use glam::{Quat, Vec3};
+use std::sync::Arc;
+use tassel::collide::Shape;
+use tassel::crowd::{ChainCrowd, CrowdPose};
+use tassel::dynamics::chain::{ChainRig, ClassicGravity, PlanarAxis, TimeMode, Wind};
+use tassel::dynamics::{ColliderSettings, RigSettings};
+use tassel::{builtin, CharacterSim, Skeleton, Transform};
+
+/// Character `i`'s world transform and animated pose at frame `f`: its own phase of a
+/// sway, a bob and a turn, the root and one more joint swinging, a teleport of character 2
+/// at frame 100.
+fn motion(sk: &Skeleton, swing: usize, i: usize, f: usize, locals: &mut [Transform]) -> Transform {
+    let t = f as f32 / 60.0 + 0.37 * i as f32;
+    locals.copy_from_slice(sk.rest());
+    locals[0].rotation = sk.rest()[0].rotation * Quat::from_rotation_z(0.3 * (2.0 * t).sin());
+    locals[swing].rotation =
+        sk.rest()[swing].rotation * Quat::from_rotation_x(0.5 * (3.0 * t + 1.0).sin());
+    let jump = if i == 2 && f >= 100 { 10.0 } else { 0.0 };
+    Transform::from_translation_rotation(
+        Vec3::new((3.0 * t).sin() * 0.5 + jump, 0.1 * (5.0 * t).sin(), t),
+        Quat::from_rotation_y(0.4 * (2.0 * t).sin()),
+    )
+}
+
+/// Frame `f`'s time step: 60 Hz with a paused frame, a hitch and a slow stretch (lanes
+/// with different step counts after a reset).
+fn dt_at(f: usize) -> f32 {
+    match f {
+        200 => 0.0,
+        300 => 0.25,
+        320..=340 => 1.0 / 45.0,
+        _ => 1.0 / 60.0,
+    }
+}
+
+fn bits(t: &Transform) -> [u32; 10] {
+    let mut b = [0u32; 10];
+    for (k, v) in t
+        .translation
+        .to_array()
+        .into_iter()
+        .chain(t.rotation.to_array())
+        .chain(t.scale.to_array())
+        .enumerate()
+    {
+        b[k] = v.to_bits();
+    }
+    b
+}
+
+/// `n` characters through `frames` frames in a crowd and one `CharacterSim` each: every
+/// local and model transform and every chain point of every character has the same bits
+/// after every frame. Returns the largest distance a point moved from its animated
+/// target (the chains really swung).
+fn assert_crowd_matches(
+    sk: &Skeleton,
+    rig: &RigSettings,
+    swing: usize,
+    n: usize,
+    frames: usize,
+) -> f32 {
+    let chains = Arc::new(ChainRig::new(sk, rig).unwrap());
+    let mut crowd = ChainCrowd::new(Arc::new(sk.clone()), chains.clone()).unwrap();
+    let mut sims: Vec<CharacterSim> = (0..n)
+        .map(|_| {
+            crowd.add();
+            CharacterSim::new(sk.clone(), rig).unwrap()
+        })
+        .collect();
+    let mut inputs = vec![(Transform::IDENTITY, sk.rest().to_vec()); n];
+    let mut locals = sk.rest().to_vec();
+    let mut models = sk.rest().to_vec();
+    let mut swung = 0.0f32;
+    for f in 0..frames {
+        if f == 400 {
+            crowd.reset(3).unwrap();
+            sims[3].reset();
+        }
+        for (i, (t, l)) in inputs.iter_mut().enumerate() {
+            *t = motion(sk, swing, i, f, l);
+        }
+        let dt = dt_at(f);
+        crowd
+            .frame(dt, |i| CrowdPose {
+                transform: inputs[i].0,
+                locals: &inputs[i].1,
+            })
+            .unwrap();
+        for (i, sim) in sims.iter_mut().enumerate() {
+            let pose = sim.frame(&inputs[i].1, inputs[i].0, dt).unwrap();
+            locals.copy_from_slice(&inputs[i].1);
+            crowd.write_pose(i, &mut locals, &mut models).unwrap();
+            for j in 0..sk.len() {
+                assert_eq!(
+                    bits(&locals[j]),
+                    bits(&pose.locals[j]),
+                    "frame {f}, character {i}, joint '{}': crowd {:?} vs single {:?}",
+                    sk.name(j),
+                    locals[j],
+                    pose.locals[j]
+                );
+                assert_eq!(bits(&models[j]), bits(&pose.models[j]), "frame {f}");
+            }
+            let state = sim.chain_state();
+            for (p, (single, target)) in state
+                .output_positions()
+                .iter()
+                .zip(state.target_positions())
+                .enumerate()
+            {
+                let c = crowd.point(i, p).unwrap();
+                assert_eq!(
+                    c.to_array().map(f32::to_bits),
+                    single.to_array().map(f32::to_bits),
+                    "frame {f}, character {i}, point {p}: crowd {c} vs single {single}"
+                );
+                swung = swung.max(single.distance(*target));
+            }
+            assert_eq!(
+                crowd.teleport_count(i),
+                Some(state.teleport_count()),
+                "frame {f}, character {i}"
+            );
+        }
+    }
+    assert!(
+        crowd.teleport_count(2).unwrap() >= 1,
+        "the teleport resets character 2"
+    );
+    swung
+}
+
+#[test]
+fn chain_crowd_gives_the_single_character_bits_on_the_bench_rig() {
+    let (sk, rig) = builtin::bench_character(16, 8, 8);
+    let swung = assert_crowd_matches(&sk, &rig, 1, 19, 600);
+    assert!(swung > 0.02, "chains barely moved ({swung} m)");
+}
+
+#[test]
+fn chain_crowd_gives_the_single_character_bits_on_the_builtin_character() {
+    let c = builtin::character();
+    let rig = RigSettings {
+        chains: c.rig.chains.clone(),
+        colliders: c.rig.colliders.clone(),
+        ..Default::default()
+    };
+    assert!(!rig.chains.is_empty());
+    for mode in [TimeMode::Fixed, TimeMode::Classic] {
+        let mut rig = rig.clone();
+        for ch in &mut rig.chains {
+            ch.mode = mode;
+        }
+        let swing = c.skeleton.len() / 2;
+        let swung = assert_crowd_matches(&c.skeleton, &rig, swing, 11, 500);
+        assert!(swung > 0.01, "{mode:?}: chains barely moved ({swung} m)");
+    }
+}
+
+/// Every chain feature the step has, chain by chain: wind with gusts, a cone limit, the
+/// planar constraints, classic mode with each gravity rule, fixed steps at 90 Hz (steps
+/// between frames, a powf pull), a step cap, warm-up steps, alpha; boxes, a plane, an
+/// inside limit, spheres and capsules.
+#[test]
+fn chain_crowd_gives_the_single_character_bits_with_every_feature() {
+    let (sk, mut rig) = builtin::bench_character(9, 6, 6);
+    for (c, ch) in rig.chains.iter_mut().enumerate() {
+        ch.stiffness = 0.2;
+        ch.teleport_distance = 2.0;
+        match c {
+            0 => {
+                ch.wind = Wind {
+                    direction: Vec3::new(1.0, 0.0, 0.5),
+                    speed: 0.01,
+                    gust: 0.5,
+                    seed: 7,
+                }
+            }
+            1 => ch.limit_angle = 0.2,
+            2 => ch.planar_constraint = PlanarAxis::X,
+            3 => {
+                ch.mode = TimeMode::Classic;
+                ch.classic_gravity = ClassicGravity::DtSquared;
+            }
+            4 => {
+                ch.mode = TimeMode::Classic;
+                ch.classic_gravity = ClassicGravity::HalfDtSquared;
+                ch.planar_constraint = PlanarAxis::Z;
+            }
+            5 => {
+                ch.target_framerate = 90.0;
+                ch.max_steps_per_frame = 3;
+            }
+            6 => {
+                ch.warmup_steps = 5;
+                ch.alpha = 0.7;
+                ch.gravity_in_world = false;
+            }
+            7 => {
+                ch.target_framerate = 30.0;
+                ch.wind = Wind {
+                    direction: Vec3::Z,
+                    speed: 0.02,
+                    gust: 1.0,
+                    seed: 3,
+                };
+            }
+            _ => ch.dummy_bone_length = 0.04,
+        }
+    }
+    rig.colliders[1].shape = Shape::Box {
+        half_extents: Vec3::new(0.05, 0.08, 0.03),
+    };
+    rig.colliders[3].rotation = Quat::from_rotation_z(0.6);
+    rig.colliders.push(ColliderSettings {
+        name: "floor".into(),
+        bone: "root".into(),
+        offset: Vec3::new(0.0, -0.32, 0.0),
+        rotation: Quat::from_rotation_x(0.1),
+        shape: Shape::Plane,
+    });
+    rig.colliders.push(ColliderSettings {
+        name: "limit".into(),
+        bone: "root".into(),
+        offset: Vec3::ZERO,
+        rotation: Quat::IDENTITY,
+        shape: Shape::Sphere {
+            radius: 0.38,
+            inside: true,
+        },
+    });
+    let swung = assert_crowd_matches(&sk, &rig, 2, 13, 600);
+    assert!(swung > 0.02, "chains barely moved ({swung} m)");
+}
+
+#[test]
+fn chain_crowd_is_the_same_on_one_and_two_threads_and_without_avx2() {
+    let (sk, settings) = builtin::bench_character(8, 6, 8);
+    let rig = Arc::new(ChainRig::new(&sk, &settings).unwrap());
+    let sk = Arc::new(sk);
+    let n = 37;
+    let run = |threads: usize, avx2: bool| -> Vec<u32> {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        let mut crowd = ChainCrowd::new(sk.clone(), rig.clone()).unwrap();
+        crowd.set_avx2(avx2);
+        for _ in 0..n {
+            crowd.add();
+        }
+        let mut inputs = vec![(Transform::IDENTITY, sk.rest().to_vec()); n];
+        pool.install(|| {
+            for f in 0..300 {
+                for (i, (t, l)) in inputs.iter_mut().enumerate() {
+                    *t = motion(&sk, 1, i, f, l);
+                }
+                crowd
+                    .frame(1.0 / 60.0, |i| CrowdPose {
+                        transform: inputs[i].0,
+                        locals: &inputs[i].1,
+                    })
+                    .unwrap();
+            }
+        });
+        (0..n)
+            .flat_map(|i| (0..rig.point_count()).map(move |p| (i, p)))
+            .flat_map(|(i, p)| crowd.point(i, p).unwrap().to_array())
+            .map(f32::to_bits)
+            .collect()
+    };
+    let one = run(1, true);
+    assert_eq!(one, run(2, true), "1 vs 2 threads");
+    assert_eq!(one, run(2, true), "run to run");
+    assert_eq!(one, run(2, false), "with and without AVX2");
+}
+
+/// Bad input names the character; its lane group keeps its state, the others step, and
+/// the next good frame goes on.
+#[test]
+fn chain_crowd_rejects_bad_input_by_character() {
+    let (sk, settings) = builtin::bench_character(4, 5, 2);
+    let rig = Arc::new(ChainRig::new(&sk, &settings).unwrap());
+    let sk = Arc::new(sk);
+    let mut crowd = ChainCrowd::new(sk.clone(), rig.clone()).unwrap();
+    for _ in 0..20 {
+        crowd.add();
+    }
+    let rest = sk.rest().to_vec();
+    let mut bad = rest.clone();
+    bad[3].translation.x = f32::NAN;
+    let at =
+        |f: usize, i: usize| Transform::from_translation(Vec3::X * (f as f32 * 0.05 + i as f32));
+    for f in 0..2 {
+        crowd
+            .frame(1.0 / 60.0, |i| CrowdPose {
+                transform: at(f, i),
+                locals: &rest,
+            })
+            .unwrap();
+    }
+    let tip = rig.point_count() - 1;
+    let before: Vec<Vec3> = (0..20).map(|i| crowd.point(i, tip).unwrap()).collect();
+    let err = crowd
+        .frame(1.0 / 60.0, |i| CrowdPose {
+            transform: at(2, i),
+            locals: if i == 17 { &bad } else { &rest },
+        })
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("crowd character 17") && err.contains(sk.name(3)),
+        "{err}"
+    );
+    for (i, b) in before.iter().enumerate() {
+        let kept = crowd.point(i, tip).unwrap() == *b;
+        assert_eq!(kept, i >= 16, "character {i}: only 17's lane group is held");
+    }
+    let short = &rest[..3];
+    let err = crowd
+        .frame(1.0 / 60.0, |i| CrowdPose {
+            transform: at(3, i),
+            locals: if i == 4 { short } else { &rest },
+        })
+        .unwrap_err();
+    assert!(err.to_string().contains("expected"), "{err}");
+    let far = Transform::from_translation(Vec3::splat(f32::INFINITY));
+    let err = crowd
+        .frame(1.0 / 60.0, |i| CrowdPose {
+            transform: if i == 9 { far } else { at(4, i) },
+            locals: &rest,
+        })
+        .unwrap_err();
+    assert!(err.to_string().contains("crowd character 9"), "{err}");
+    for dt in [f32::NAN, -1.0, f32::INFINITY] {
+        assert!(crowd
+            .frame(dt, |_| CrowdPose {
+                transform: Transform::IDENTITY,
+                locals: &rest,
+            })
+            .is_err());
+    }
+    crowd
+        .frame(1.0 / 60.0, |i| CrowdPose {
+            transform: at(5, i),
+            locals: &rest,
+        })
+        .unwrap();
+    for i in 0..20 {
+        assert!(crowd.point(i, tip).unwrap().is_finite());
+    }
+    assert!(crowd.point(20, 0).is_none() && crowd.reset(20).is_err());
+    assert!(crowd.point(0, rig.point_count()).is_none());
+    let mut short_locals = rest[..2].to_vec();
+    let mut models = rest.clone();
+    assert!(crowd.write_pose(0, &mut short_locals, &mut models).is_err());
+}
+
+/// Characters removed mid-run (`swap_remove`, the last taking the index) and added again:
+/// everyone left carries on with the bits of their own `CharacterSim`, and a character
+/// added into a freed lane starts afresh.
+#[test]
+fn chain_crowd_removes_and_adds_characters() {
+    let (sk, mut settings) = builtin::bench_character(6, 5, 8);
+    settings.chains[1].wind = Wind {
+        direction: Vec3::X,
+        speed: 0.01,
+        gust: 0.5,
+        seed: 11,
+    };
+    settings.chains[2].target_framerate = 90.0;
+    let rig = Arc::new(ChainRig::new(&sk, &settings).unwrap());
+    let mut crowd = ChainCrowd::new(Arc::new(sk.clone()), rig.clone()).unwrap();
+    // Who is where: the crowd index of each live single-character reference.
+    let mut sims: Vec<(usize, CharacterSim)> = Vec::new();
+    for k in 0..21 {
+        crowd.add();
+        sims.push((k, CharacterSim::new(sk.clone(), &settings).unwrap()));
+    }
+    let mut locals = sk.rest().to_vec();
+    let mut models = sk.rest().to_vec();
+    let mut inputs = vec![(Transform::IDENTITY, sk.rest().to_vec()); 40];
+    for f in 0..240 {
+        if f == 60 {
+            // Remove character 3 (the last takes its index), then the new last one.
+            for gone in [3usize, 19] {
+                crowd.swap_remove(gone).unwrap();
+                let last = sims.len() - 1;
+                sims.swap(gone, last);
+                sims.pop();
+            }
+        }
+        if f == 120 {
+            for _ in 0..4 {
+                let k = sims.len() + 100;
+                crowd.add();
+                sims.push((k, CharacterSim::new(sk.clone(), &settings).unwrap()));
+            }
+        }
+        // Each character's motion follows its identity, not its index.
+        for (i, (who, _)) in sims.iter().enumerate() {
+            let (t, l) = &mut inputs[i];
+            *t = motion(&sk, 1, *who, f, l);
+        }
+        crowd
+            .frame(1.0 / 60.0, |i| CrowdPose {
+                transform: inputs[i].0,
+                locals: &inputs[i].1,
+            })
+            .unwrap();
+        assert_eq!(crowd.len(), sims.len());
+        for (i, (who, sim)) in sims.iter_mut().enumerate() {
+            let pose = sim.frame(&inputs[i].1, inputs[i].0, 1.0 / 60.0).unwrap();
+            locals.copy_from_slice(&inputs[i].1);
+            crowd.write_pose(i, &mut locals, &mut models).unwrap();
+            for j in 0..sk.len() {
+                assert_eq!(
+                    bits(&locals[j]),
+                    bits(&pose.locals[j]),
+                    "frame {f}, index {i} (character {who}), joint {j}"
+                );
+            }
+        }
+    }
+}
