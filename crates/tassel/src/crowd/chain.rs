@@ -13,8 +13,11 @@ use super::lanes::{rotation_arc, Trs, F, LANES, M, Q, V3};
 use super::CrowdPose;
 use crate::collide::PlacedCollider;
 use crate::dynamics::chain::compile::ChainRig;
-use crate::dynamics::chain::job::{gather_targets, gravity_cs, motion_cs, slerp_angle, wind_cs};
-use crate::dynamics::chain::{ChainSettings, ClassicGravity, TimeMode};
+use crate::dynamics::chain::job::{
+    chain_rng, gather_targets, gravity_cs, motion_cs, slerp_angle, wind_cs,
+};
+use crate::dynamics::chain::step::gravity_step;
+use crate::dynamics::chain::{ChainSettings, TimeMode};
 use crate::dynamics::path::CharacterPath;
 use crate::error::{Error, Result};
 use crate::math::Transform;
@@ -56,11 +59,6 @@ struct Pack {
     error: Option<(usize, Error)>,
 }
 
-/// A chain's wind generator for a fresh character (as [`crate::dynamics::chain::ChainState`]).
-fn fresh_rng(rig: &ChainRig, ci: usize) -> SplitMix64 {
-    SplitMix64::new(rig.chains[ci].settings.wind.seed ^ (ci as u64) << 32)
-}
-
 impl Pack {
     fn new(rig: &ChainRig) -> Pack {
         let n = rig.point_count();
@@ -82,7 +80,7 @@ impl Pack {
             last_step_component: vec![id; c],
             accumulator: vec![F::splat(0.0); c],
             dt_old: vec![F::splat(0.0); c],
-            rng: (0..c).map(|ci| [fresh_rng(rig, ci); LANES]).collect(),
+            rng: (0..c).map(|ci| [chain_rng(rig, ci); LANES]).collect(),
             needs_reset: vec![[true; LANES]; c],
             paths: [CharacterPath::default(); LANES],
             prev_component: id,
@@ -95,7 +93,7 @@ impl Pack {
     /// Lane `l` as a fresh character (the first frame starts it from its pose).
     fn clear_lane(&mut self, rig: &ChainRig, l: usize) {
         for (ci, r) in self.rng.iter_mut().enumerate() {
-            r[l] = fresh_rng(rig, ci);
+            r[l] = chain_rng(rig, ci);
         }
         for n in &mut self.needs_reset {
             n[l] = true;
@@ -520,15 +518,6 @@ struct Ctx<'c> {
     reach: &'c [Option<f32>],
     dt: f32,
     avx2: bool,
-}
-
-/// Gravity's share of one step of `dt` (the chain step's formula for the time mode).
-fn gravity_step(s: &ChainSettings, g: Vec3, dt: f32, fixed: bool) -> Vec3 {
-    match (fixed, s.classic_gravity) {
-        (true, _) | (false, ClassicGravity::DtSquared) => g * dt * dt,
-        (false, ClassicGravity::PerFrame) => g * dt,
-        (false, ClassicGravity::HalfDtSquared) => g * (0.5 * dt * dt),
-    }
 }
 
 /// The per-lane inputs of a step that depend on where each character is: its motion since
@@ -968,7 +957,7 @@ impl Ctx<'_> {
                 }
             }));
             for p in chain.points.clone() {
-                s.step_targets[p] = s.prev_targets_lerp(pack, p, w);
+                s.step_targets[p] = pack.prev_targets[p].lerp(s.targets[p], w);
                 s.step_normals[p] = pack.prev_normals[p]
                     .lerp(s.normals[p], w)
                     .normalize_or(s.normals[p]);
@@ -1038,13 +1027,5 @@ impl Ctx<'_> {
             }
         }
         pack.accumulator[ci] = acc;
-    }
-}
-
-impl Scratch {
-    /// A step's target of point `p`: last frame's and this frame's, interpolated by `w`.
-    #[inline(always)]
-    fn prev_targets_lerp(&self, pack: &Pack, p: usize, w: F) -> V3 {
-        pack.prev_targets[p].lerp(self.targets[p], w)
     }
 }

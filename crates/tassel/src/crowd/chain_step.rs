@@ -8,10 +8,10 @@
 use super::lanes::{differs, F, LANES, M, Q, V3};
 use crate::collide::PlacedCollider;
 use crate::dynamics::chain::compile::{ChainRig, NONE};
+use crate::dynamics::chain::step::{cone_limit, pull};
 use crate::dynamics::chain::PlanarAxis;
-use crate::math::normalize_or;
 use crate::rng::SplitMix64;
-use glam::{Quat, Vec3};
+use glam::Vec3;
 
 /// A collider's broad-phase sphere per lane ([`PlacedCollider::bound_sphere`]): centre and
 /// radius with the collider's part of the margin.
@@ -58,15 +58,17 @@ pub(super) struct LaneStep<'a> {
     pub active: M,
 }
 
-/// glam's `Vec3::min` per lane (`a < b ? a : b`, glam's NaN rule).
+/// `pick(a, b) ? a : b` per component and lane.
 #[inline(always)]
-fn vmin(a: V3, b: V3) -> V3 {
+fn pick(a: V3, b: V3, take_a: impl Fn(f32, f32) -> bool) -> V3 {
     let f = |a: F, b: F| {
-        let mut r = [0.0f32; LANES];
-        for i in 0..LANES {
-            r[i] = if a.0[i] < b.0[i] { a.0[i] } else { b.0[i] };
-        }
-        F(r)
+        F(std::array::from_fn(|i| {
+            if take_a(a.0[i], b.0[i]) {
+                a.0[i]
+            } else {
+                b.0[i]
+            }
+        }))
     };
     V3 {
         x: f(a.x, b.x),
@@ -75,21 +77,16 @@ fn vmin(a: V3, b: V3) -> V3 {
     }
 }
 
+/// glam's `Vec3::min` per lane (`a < b ? a : b`, glam's NaN rule).
+#[inline(always)]
+fn vmin(a: V3, b: V3) -> V3 {
+    pick(a, b, |a, b| a < b)
+}
+
 /// glam's `Vec3::max` per lane (`a > b ? a : b`).
 #[inline(always)]
 fn vmax(a: V3, b: V3) -> V3 {
-    let f = |a: F, b: F| {
-        let mut r = [0.0f32; LANES];
-        for i in 0..LANES {
-            r[i] = if a.0[i] > b.0[i] { a.0[i] } else { b.0[i] };
-        }
-        F(r)
-    };
-    V3 {
-        x: f(a.x, b.x),
-        y: f(a.y, b.y),
-        z: f(a.z, b.z),
-    }
+    pick(a, b, |a, b| a > b)
 }
 
 /// [`crate::collide::NearSet::of`] per lane: bit `i` of lane `l` set when the list's member `i` may touch
@@ -236,15 +233,7 @@ pub(super) fn step_lanes(
         x = x + input.gravity_step;
 
         let base = pos[pp] + (t[p] - t[pp]);
-        let k = rig.stiffness[p];
-        let pull = if k >= 1.0 {
-            1.0
-        } else if exponent == 1.0 {
-            1.0 - (1.0 - k)
-        } else {
-            1.0 - (1.0 - k).powf(exponent)
-        };
-        x = x + (base - x) * F::splat(pull);
+        x = x + (base - x) * F::splat(pull(rig.stiffness[p], exponent));
 
         let r = rig.radius[p];
         let anim_dir = t[p] - t[pp];
@@ -276,14 +265,8 @@ pub(super) fn step_lanes(
                 if active.0[l] == 0 {
                     continue;
                 }
-                let (xl, ppl, ad) = (x.get(l), parent_pos.get(l), anim_dir.get(l));
-                let d = xl - ppl;
-                let angle = d.angle_between(ad);
-                if angle.is_finite() && angle > limit {
-                    let axis = normalize_or(ad.cross(d), ad.any_orthonormal_vector());
-                    let dir = Quat::from_axis_angle(axis, limit) * normalize_or(ad, Vec3::Y);
-                    x.set(l, ppl + dir * d.length());
-                }
+                let limited = cone_limit(x.get(l), parent_pos.get(l), anim_dir.get(l), limit);
+                x.set(l, limited);
             }
         }
         if s.planar_constraint != PlanarAxis::None {

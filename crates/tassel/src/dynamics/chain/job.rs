@@ -85,12 +85,7 @@ impl ChainState {
             last_step_component: vec![Transform::IDENTITY; c],
             accumulator: vec![0.0; c],
             dt_old: vec![0.0; c],
-            rng: rig
-                .chains
-                .iter()
-                .enumerate()
-                .map(|(i, ch)| SplitMix64::new(ch.settings.wind.seed ^ (i as u64) << 32))
-                .collect(),
+            rng: (0..c).map(|ci| chain_rng(rig, ci)).collect(),
             needs_reset: vec![true; c],
             teleports: 0,
         }
@@ -126,6 +121,11 @@ impl ChainState {
     pub fn teleport_count(&self) -> u64 {
         self.teleports
     }
+}
+
+/// Chain `ci`'s wind generator for a fresh character.
+pub(crate) fn chain_rng(rig: &ChainRig, ci: usize) -> SplitMix64 {
+    SplitMix64::new(rig.chains[ci].settings.wind.seed ^ (ci as u64) << 32)
 }
 
 /// One frame of every chain of a character.

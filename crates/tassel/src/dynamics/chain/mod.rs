@@ -9,7 +9,7 @@
 pub(crate) mod compile;
 pub(crate) mod job;
 mod settings;
-mod step;
+pub(crate) mod step;
 
 pub use compile::{ChainRig, PointInfo};
 pub use job::{ChainJob, ChainState};

@@ -1,7 +1,7 @@
 //! One solver step of one chain: the readable, per-point reference path.
 
 use super::compile::{ChainRig, NONE};
-use super::settings::{ClassicGravity, PlanarAxis};
+use super::settings::{ChainSettings, ClassicGravity, PlanarAxis};
 use crate::collide::{NearSet, PlacedCollider};
 use crate::math::normalize_or;
 use crate::rng::SplitMix64;
@@ -46,12 +46,7 @@ pub(crate) fn step_chain(
     let chain = &rig.chains[ci];
     let s = &chain.settings;
     let exponent = s.target_framerate * input.dt;
-    let (g, dt) = (input.gravity_cs, input.dt);
-    let gravity_step = match (input.fixed, s.classic_gravity) {
-        (true, _) | (false, ClassicGravity::DtSquared) => g * dt * dt,
-        (false, ClassicGravity::PerFrame) => g * dt,
-        (false, ClassicGravity::HalfDtSquared) => g * (0.5 * dt * dt),
-    };
+    let gravity_step = gravity_step(s, input.gravity_cs, input.dt, input.fixed);
     let wind_on = s.wind.speed > 0.0 && input.wind_cs != Vec3::ZERO;
     let t = input.targets;
     for p in chain.points.clone() {
@@ -84,16 +79,7 @@ pub(crate) fn step_chain(
 
         // Pull toward the animated pose, relative to the simulated parent.
         let base = pos[pp] + (t[p] - t[pp]);
-        let k = rig.stiffness[p];
-        let pull = if k >= 1.0 {
-            1.0
-        } else if exponent == 1.0 {
-            // Fixed steps at the target rate: x^1 is x (powf gives exactly that, slowly).
-            1.0 - (1.0 - k)
-        } else {
-            1.0 - (1.0 - k).powf(exponent)
-        };
-        x += (base - x) * pull;
+        x += (base - x) * pull(rig.stiffness[p], exponent);
 
         let r = rig.radius[p];
         // Broad phase: every point the colliders see below starts as `x` now or as a point
@@ -122,13 +108,7 @@ pub(crate) fn step_chain(
         let anim_dir = t[p] - t[pp];
         let limit = rig.limit_angle[p];
         if limit > 0.0 {
-            let d = x - pos[pp];
-            let angle = d.angle_between(anim_dir);
-            if angle.is_finite() && angle > limit {
-                let axis = normalize_or(anim_dir.cross(d), anim_dir.any_orthonormal_vector());
-                let dir = Quat::from_axis_angle(axis, limit) * normalize_or(anim_dir, Vec3::Y);
-                x = pos[pp] + dir * d.length();
-            }
+            x = cone_limit(x, pos[pp], anim_dir, limit);
         }
         if s.planar_constraint != PlanarAxis::None {
             let n = input.normals[p];
@@ -155,5 +135,42 @@ pub(crate) fn step_chain(
             }
         }
         pos[p] = x;
+    }
+}
+
+/// Gravity's share of one step of `dt` for the chain's time mode (fixed: an acceleration;
+/// classic: the chain's rule).
+pub(crate) fn gravity_step(s: &ChainSettings, g: Vec3, dt: f32, fixed: bool) -> Vec3 {
+    match (fixed, s.classic_gravity) {
+        (true, _) | (false, ClassicGravity::DtSquared) => g * dt * dt,
+        (false, ClassicGravity::PerFrame) => g * dt,
+        (false, ClassicGravity::HalfDtSquared) => g * (0.5 * dt * dt),
+    }
+}
+
+/// The share of the way to the animated pose a point with stiffness `k` moves in a step
+/// of `exponent` target frames.
+#[inline]
+pub(crate) fn pull(k: f32, exponent: f32) -> f32 {
+    if k >= 1.0 {
+        1.0
+    } else if exponent == 1.0 {
+        // Fixed steps at the target rate: x^1 is x (powf gives exactly that, slowly).
+        1.0 - (1.0 - k)
+    } else {
+        1.0 - (1.0 - k).powf(exponent)
+    }
+}
+
+/// `x` kept within `limit` radians of the animated direction `anim_dir` about `parent`.
+pub(crate) fn cone_limit(x: Vec3, parent: Vec3, anim_dir: Vec3, limit: f32) -> Vec3 {
+    let d = x - parent;
+    let angle = d.angle_between(anim_dir);
+    if angle.is_finite() && angle > limit {
+        let axis = normalize_or(anim_dir.cross(d), anim_dir.any_orthonormal_vector());
+        let dir = Quat::from_axis_angle(axis, limit) * normalize_or(anim_dir, Vec3::Y);
+        parent + dir * d.length()
+    } else {
+        x
     }
 }
