@@ -10,8 +10,7 @@ use glam::{DVec3, Vec3};
 /// that passed right through) stops where it met the surface and keeps the tangential
 /// part of the rest of its step, so a point sliding along the capsule slides on.
 pub fn push_out_of_capsule(p: Vec3, prev: Vec3, a: Vec3, b: Vec3, limit: f32) -> Vec3 {
-    let tol = crate::collide::contact_tolerance(limit);
-    let inner = (limit - tol).max(0.0);
+    let inner = crate::collide::entry_radius(limit);
     let dist = |q: Vec3| (q - closest_point_on_segment(q, a, b)).length();
     let prev_fallback = || {
         normalize_or(

@@ -82,6 +82,12 @@ pub(crate) fn contact_tolerance(limit: f32) -> f32 {
     1e-4 * limit
 }
 
+/// The distance of the entry surface a swept test uses: `limit` less the
+/// [`contact_tolerance`] (never below 0).
+pub(crate) fn entry_radius(limit: f32) -> f32 {
+    (limit - contact_tolerance(limit)).max(0.0)
+}
+
 /// The colliders of a list (by position in it) that may act on a point inside one box
 /// (by their [`PlacedCollider::bound_sphere`]); positions from 64 on always may.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -250,7 +256,7 @@ impl PlacedCollider {
         }
     }
 
-    fn capsule_ends(&self, length: f32) -> (Vec3, Vec3) {
+    pub(crate) fn capsule_ends(&self, length: f32) -> (Vec3, Vec3) {
         let axis = self.transform.rotation * Vec3::Y * (0.5 * length);
         (
             self.transform.translation - axis,

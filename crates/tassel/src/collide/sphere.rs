@@ -13,7 +13,7 @@ use glam::Vec3;
 /// keeps the tangential part of the rest of its step: it slides, it is never sent back to
 /// `prev`. That also catches a step that passed right through (tunnelling).
 pub fn push_out_of_sphere(p: Vec3, prev: Vec3, center: Vec3, limit: f32) -> Vec3 {
-    let inner2 = (limit - super::contact_tolerance(limit)).max(0.0).powi(2);
+    let inner2 = super::entry_radius(limit).powi(2);
     let prev_out = (prev - center).length_squared() >= inner2;
     let c = closest_point_on_segment(center, prev, p);
     if prev_out && (c - center).length_squared() < inner2 {

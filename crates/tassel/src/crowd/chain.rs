@@ -6,9 +6,10 @@
 //! placed colliders, the character's path and motion, the write-back of rotations. Per
 //! lane group: the solver steps and the output pass ([`super::chain_step`]), where a
 //! character's own branches (a reset, a step count, a contact) are lane masks and the
-//! narrow phase asks the scalar colliders for the lanes whose point may touch one.
+//! narrow phase asks the scalar colliders for the lanes whose point may touch one (see
+//! `chain_step`: the contact decision of spheres and capsules runs in lanes too).
 
-use super::chain_step::{output_lanes, step_lanes, Bound, LaneStep};
+use super::chain_step::{output_lanes, step_lanes, Bound, LaneShape, LaneStep};
 use super::lanes::{rotation_arc, Trs, F, LANES, M, Q, V3};
 use super::CrowdPose;
 use crate::collide::PlacedCollider;
@@ -220,6 +221,8 @@ struct Scratch {
     /// One character's targets and normals, for the scalar code.
     one_targets: Vec<Vec3>,
     one_normals: Vec<Vec3>,
+    /// A point's broad phase: the lanes each member of its chain's collider list may touch.
+    near: Vec<M>,
 }
 
 impl Scratch {
@@ -243,6 +246,14 @@ impl Scratch {
             rotations: vec![Q::splat(Quat::IDENTITY); joints],
             one_targets: vec![Vec3::ZERO; n],
             one_normals: vec![Vec3::Y; n],
+            near: vec![
+                M::ALL;
+                rig.chains
+                    .iter()
+                    .map(|c| c.colliders.len())
+                    .max()
+                    .unwrap_or(0)
+            ],
         }
     }
 }
@@ -292,7 +303,7 @@ pub struct ChainCrowd {
     packs: Vec<Pack>,
     len: usize,
     scratch: Vec<Scratch>,
-    reach: Vec<Option<f32>>,
+    shapes: Vec<LaneShape>,
     avx2: bool,
 }
 
@@ -306,16 +317,10 @@ impl ChainCrowd {
                 got: rig.joint_count(),
             });
         }
-        let reach = rig
+        let shapes = rig
             .colliders
             .iter()
-            .map(|c| {
-                PlacedCollider {
-                    shape: c.shape,
-                    transform: Transform::IDENTITY,
-                }
-                .bounding_radius()
-            })
+            .map(|c| LaneShape::of(c.shape))
             .collect();
         Ok(Self {
             skeleton,
@@ -323,7 +328,7 @@ impl ChainCrowd {
             packs: Vec::new(),
             len: 0,
             scratch: Vec::new(),
-            reach,
+            shapes,
             avx2: true,
         })
     }
@@ -485,7 +490,7 @@ impl ChainCrowd {
         let ctx = Ctx {
             sk: &self.skeleton,
             rig: &self.rig,
-            reach: &self.reach,
+            shapes: &self.shapes,
             dt,
             avx2: self.avx2,
         };
@@ -514,8 +519,8 @@ impl ChainCrowd {
 struct Ctx<'c> {
     sk: &'c Skeleton,
     rig: &'c ChainRig,
-    /// Each collider's bounding radius (`None`: it acts everywhere).
-    reach: &'c [Option<f32>],
+    /// Each rig collider's shape as the lanes see it.
+    shapes: &'c [LaneShape],
     dt: f32,
     avx2: bool,
 }
@@ -646,9 +651,7 @@ impl Ctx<'_> {
                 d.set(lane, *v);
             }
             for (b, c) in scratch.bounds.iter_mut().zip(colliders.iter()) {
-                let s = c.bound_sphere();
-                b.c.set(lane, s.truncate());
-                b.w.0[lane] = s.w;
+                b.set(lane, c);
             }
         }
         Ok(())
@@ -796,9 +799,10 @@ impl Ctx<'_> {
             &pack.dev,
             &s.colliders,
             &s.bounds,
-            self.reach,
+            self.shapes,
             &mut pack.out,
             live,
+            &mut s.near,
         );
     }
 
@@ -840,7 +844,7 @@ impl Ctx<'_> {
                     normals: &s.normals,
                     colliders: &s.colliders,
                     bounds: &s.bounds,
-                    reach: self.reach,
+                    shapes: self.shapes,
                     move_cs: mo.move_cs,
                     rotate_cs: mo.rotate_cs,
                     gravity_step: mo.gravity_step,
@@ -857,6 +861,7 @@ impl Ctx<'_> {
                     &mut pack.pos,
                     &mut pack.prev,
                     &mut pack.rng[ci],
+                    &mut s.near,
                 );
             }
         }
@@ -891,7 +896,7 @@ impl Ctx<'_> {
                 normals: &s.normals,
                 colliders: &s.colliders,
                 bounds: &s.bounds,
-                reach: self.reach,
+                shapes: self.shapes,
                 move_cs: mo.move_cs,
                 rotate_cs: mo.rotate_cs,
                 gravity_step: mo.gravity_step,
@@ -908,6 +913,7 @@ impl Ctx<'_> {
                 &mut pack.pos,
                 &mut pack.prev,
                 &mut pack.rng[ci],
+                &mut s.near,
             );
             pack.dt_old[ci] = F::select(run, F::splat(dt), pack.dt_old[ci]);
         }
@@ -968,9 +974,7 @@ impl Ctx<'_> {
                     if active.0[l] != 0 && s.step_placed_at[at].to_bits() != w.0[l].to_bits() {
                         s.step_colliders[at] =
                             pack.prev_colliders[at].lerp(&s.colliders[at], w.0[l]);
-                        let b = s.step_colliders[at].bound_sphere();
-                        s.step_bounds[c].c.set(l, b.truncate());
-                        s.step_bounds[c].w.0[l] = b.w;
+                        s.step_bounds[c].set(l, &s.step_colliders[at]);
                         s.step_placed_at[at] = w.0[l];
                     }
                 }
@@ -994,7 +998,7 @@ impl Ctx<'_> {
                 normals: &s.step_normals,
                 colliders: &s.step_colliders,
                 bounds: &s.step_bounds,
-                reach: self.reach,
+                shapes: self.shapes,
                 move_cs: mo.move_cs,
                 rotate_cs: mo.rotate_cs,
                 gravity_step: mo.gravity_step,
@@ -1011,6 +1015,7 @@ impl Ctx<'_> {
                 &mut pack.pos,
                 &mut pack.prev,
                 &mut pack.rng[ci],
+                &mut s.near,
             );
             pack.last_step_component[ci] =
                 Trs::select(active, &comp_b, &pack.last_step_component[ci]);

@@ -2,11 +2,15 @@
 //! pass, for [`LANES`] characters side by side. Each is
 //! [`crate::dynamics::chain::step`]'s and the chain job's output pass, operation for
 //! operation ([`super::lanes`] repeats glam's IEEE operations lane by lane), with every
-//! branch that depends on a character's state taken per lane (a mask) and the narrow
-//! phase left to the scalar colliders, asked for the lanes whose point may touch one.
+//! branch that depends on a character's state taken per lane (a mask). The broad phase,
+//! the colliders' quick rejection and, for keep-out spheres and capsules, the narrow
+//! phase's own contact decision run in lanes; the narrow phase itself is left to the
+//! scalar colliders, asked only for the lanes those leave.
 
-use super::lanes::{differs, F, LANES, M, Q, V3};
-use crate::collide::PlacedCollider;
+use super::lanes::{
+    closest_params_segment_segment, closest_point_on_segment, differs, F, LANES, M, Q, V3,
+};
+use crate::collide::{entry_radius, PlacedCollider, Shape};
 use crate::dynamics::chain::compile::{ChainRig, NONE};
 use crate::dynamics::chain::step::{cone_limit, pull};
 use crate::dynamics::chain::PlanarAxis;
@@ -14,22 +18,105 @@ use crate::rng::SplitMix64;
 use glam::Vec3;
 
 /// A collider's broad-phase sphere per lane ([`PlacedCollider::bound_sphere`]): centre and
-/// radius with the collider's part of the margin.
+/// radius with the collider's part of the margin; and for a capsule its axis ends.
 #[derive(Debug, Clone, Copy)]
 pub(super) struct Bound {
     pub c: V3,
     pub w: F,
+    /// A capsule's axis ends ([`PlacedCollider::capsule_ends`]; other shapes: the centre).
+    pub a: V3,
+    pub b: V3,
 }
 
 impl Bound {
     pub(super) const ZERO: Bound = Bound {
-        c: V3 {
-            x: F([0.0; LANES]),
-            y: F([0.0; LANES]),
-            z: F([0.0; LANES]),
-        },
+        c: V3::ZERO,
         w: F([0.0; LANES]),
+        a: V3::ZERO,
+        b: V3::ZERO,
     };
+
+    /// Lane `l` from its placed collider.
+    #[inline]
+    pub(super) fn set(&mut self, l: usize, c: &PlacedCollider) {
+        let s = c.bound_sphere();
+        self.c.set(l, s.truncate());
+        self.w.0[l] = s.w;
+        let (a, b) = match c.shape {
+            Shape::Capsule { length, .. } => c.capsule_ends(length),
+            _ => (c.transform.translation, c.transform.translation),
+        };
+        self.a.set(l, a);
+        self.b.set(l, b);
+    }
+}
+
+/// What the lanes know of a rig collider's shape (the same for every character).
+#[derive(Debug, Clone, Copy)]
+pub(super) struct LaneShape {
+    /// Its bounding radius ([`PlacedCollider::bounding_radius`]; `None`: it acts
+    /// everywhere).
+    pub reach: Option<f32>,
+    /// The radius of a keep-out sphere or capsule, whose no-contact decision the lanes
+    /// make themselves; `None` for the other shapes (always asked).
+    pub swept: Option<f32>,
+    /// Whether it is a capsule (else a sphere, when `swept`).
+    pub capsule: bool,
+}
+
+impl LaneShape {
+    pub(super) fn of(shape: Shape) -> LaneShape {
+        let reach = PlacedCollider {
+            shape,
+            transform: crate::math::Transform::IDENTITY,
+        }
+        .bounding_radius();
+        let (swept, capsule) = match shape {
+            Shape::Sphere {
+                radius,
+                inside: false,
+            } => (Some(radius), false),
+            Shape::Capsule { radius, .. } => (Some(radius), true),
+            _ => (None, false),
+        };
+        LaneShape {
+            reach,
+            swept,
+            capsule,
+        }
+    }
+}
+
+/// The lanes whose point `p` (the step from `prev`) a keep-out sphere may move, decided
+/// as [`crate::collide::push_out_of_sphere`] decides it, with its operations: the step
+/// entered the entry surface from outside it, or `p` lies inside `limit`. Every other
+/// lane gets `p` back from it unchanged.
+#[inline(always)]
+fn sphere_may_move(p: V3, prev: V3, center: V3, limit: f32) -> M {
+    let inner2 = F::splat(entry_radius(limit).powi(2));
+    let from = prev - center;
+    let prev_out = inner2.le(from.dot(from));
+    let c = closest_point_on_segment(center, prev, p) - center;
+    let entered = prev_out.and(c.dot(c).lt(inner2));
+    let d = p - center;
+    entered.or(d.dot(d).lt(F::splat(limit * limit)))
+}
+
+/// The lanes whose point a capsule `a`–`b` may move, as
+/// [`crate::collide::push_out_of_capsule`] decides it: the step started at or beyond the
+/// entry surface and its closest approach to the axis is inside it, or `p` lies inside
+/// `limit`.
+#[inline(always)]
+fn capsule_may_move(p: V3, prev: V3, a: V3, b: V3, limit: f32) -> M {
+    let inner = F::splat(entry_radius(limit));
+    let prev_dist = (prev - closest_point_on_segment(prev, a, b)).length();
+    let (s, t) = closest_params_segment_segment(prev, p, a, b);
+    let on_path = prev + (p - prev) * s;
+    let on_axis = a + (b - a) * t;
+    let gap = on_path - on_axis;
+    let entered = inner.le(prev_dist).and(gap.dot(gap).lt(inner * inner));
+    let d = p - closest_point_on_segment(p, a, b);
+    entered.or(d.dot(d).lt(F::splat(limit * limit)))
 }
 
 /// Everything one lane step reads besides the rig and the points (as
@@ -43,8 +130,8 @@ pub(super) struct LaneStep<'a> {
     pub colliders: &'a [PlacedCollider],
     /// Their broad-phase spheres per collider.
     pub bounds: &'a [Bound],
-    /// Each collider's bounding radius (`None`: it acts everywhere).
-    pub reach: &'a [Option<f32>],
+    /// Each rig collider's shape as the lanes see it.
+    pub shapes: &'a [LaneShape],
     pub move_cs: V3,
     pub rotate_cs: Q,
     /// Gravity's share of the step (the time mode's formula, per lane).
@@ -89,52 +176,49 @@ fn vmax(a: V3, b: V3) -> V3 {
     pick(a, b, |a, b| a > b)
 }
 
-/// [`crate::collide::NearSet::of`] per lane: bit `i` of lane `l` set when the list's member `i` may touch
-/// the lane's box `lo`–`hi` for a point of radius `r`.
+/// [`crate::collide::NearSet::of`] per lane, into `near`: member `i` of the list may touch
+/// the lane's box `lo`–`hi` for a point of radius `r` in the lanes of `near[i]` (a mask
+/// per member rather than a bit set per lane, so that the narrow phase reads it as is).
 #[inline(always)]
-fn near_sets(list: &[usize], bounds: &[Bound], lo: V3, hi: V3, r: f32) -> [u64; LANES] {
-    let finite = lo.finite().and(hi.finite());
+fn near_sets(list: &[usize], bounds: &[Bound], lo: V3, hi: V3, r: f32, near: &mut [M]) {
+    // A non-finite box or radius may touch everything, as may members from 64 on.
+    let everywhere = if r.is_finite() {
+        lo.finite().and(hi.finite()).not()
+    } else {
+        M::ALL
+    };
     // glam's `max_element` of `lo.abs().max(hi.abs())`: max(x, max(y, z)).
     let size = vmax(lo.abs(), hi.abs());
     let yz = vmax(V3::splat_f(size.y), V3::splat_f(size.z)).x;
     let largest = vmax(V3::splat_f(size.x), V3::splat_f(yz)).x;
     let extra = F::splat(r) + F::splat(1e-5) * (largest + F::splat(r));
-    let mut bits = [0u64; LANES];
     let zero = V3::splat(Vec3::ZERO);
-    for (i, &k) in list.iter().take(64).enumerate() {
+    for (i, (&k, out)) in list.iter().zip(near.iter_mut()).enumerate() {
+        if i >= 64 {
+            *out = M::ALL;
+            continue;
+        }
         let b = bounds[k];
         let d = vmax(vmax(lo - b.c, b.c - hi), zero);
         let reach = b.w + extra;
-        let near = d.dot(d).le(reach * reach);
-        for (l, bits) in bits.iter_mut().enumerate() {
-            *bits |= u64::from(near.0[l] & 1) << i;
-        }
+        *out = d.dot(d).le(reach * reach).or(everywhere);
     }
-    if !r.is_finite() {
-        return [u64::MAX; LANES];
-    }
-    for (l, bits) in bits.iter_mut().enumerate() {
-        if finite.0[l] == 0 {
-            *bits = u64::MAX;
-        }
-    }
-    bits
 }
 
 /// [`NearSet::resolve`] for the `open` lanes: the members of the list in order, each asked
 /// for the lanes whose set holds it or whose point a member before it moved; and of
 /// those, only the lanes that [`PlacedCollider::resolve`]'s own quick rejection (both
 /// ends of the step beyond the shape's bounding sphere, the step too short to reach it)
-/// does not turn away, computed here for all lanes at once with its operations.
-/// `reach` holds each collider's bounding radius (`None`: acts everywhere).
+/// and, for keep-out spheres and capsules, the narrow phase's own contact decision do not
+/// turn away, computed here for all lanes at once with their operations.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 fn collide(
     list: &[usize],
     colliders: &[PlacedCollider],
     bounds: &[Bound],
-    reach: &[Option<f32>],
-    sets: &[u64; LANES],
+    shapes: &[LaneShape],
+    near: &[M],
     x: V3,
     prev: Option<V3>,
     r: f32,
@@ -143,23 +227,18 @@ fn collide(
     let m = colliders.len() / LANES;
     let mut y = x;
     for (i, &c) in list.iter().enumerate() {
-        let near = if i >= 64 {
-            M::ALL
-        } else {
-            M(std::array::from_fn(|l| {
-                0u32.wrapping_sub(((sets[l] >> i) & 1) as u32)
-            }))
-        };
-        let mut ask = open.and(near.or(differs(y, x)));
+        let mut ask = open.and(near[i].or(differs(y, x)));
         if !ask.any() {
             continue;
         }
         let q = prev.unwrap_or(y);
-        if let Some(bound) = reach[c] {
-            let reach = F::splat(bound + r);
+        let shape = shapes[c];
+        let bound = &bounds[c];
+        if let Some(reach) = shape.reach {
+            let reach = F::splat(reach + r);
             let reach2 = reach * reach;
-            let dp = y - bounds[c].c;
-            let dq = q - bounds[c].c;
+            let dp = y - bound.c;
+            let dq = q - bound.c;
             let step = y - q;
             let gap = dp.length() - reach;
             let rejected = dp
@@ -168,6 +247,18 @@ fn collide(
                 .and(dq.dot(dq).gt(reach2))
                 .and(step.dot(step).lt(gap * gap));
             ask = ask.and(rejected.not());
+            if !ask.any() {
+                continue;
+            }
+        }
+        if let Some(radius) = shape.swept {
+            let limit = radius + r;
+            let may_move = if shape.capsule {
+                capsule_may_move(y, q, bound.a, bound.b, limit)
+            } else {
+                sphere_may_move(y, q, bound.c, limit)
+            };
+            ask = ask.and(may_move);
         }
         for l in 0..LANES {
             if ask.0[l] != 0 {
@@ -189,6 +280,7 @@ pub(super) fn step_lanes(
     pos: &mut [V3],
     prev: &mut [V3],
     rng: &mut [SplitMix64; LANES],
+    near: &mut [M],
 ) {
     let chain = &rig.chains[ci];
     let s = &chain.settings;
@@ -239,76 +331,62 @@ pub(super) fn step_lanes(
         let anim_dir = t[p] - t[pp];
         let length = anim_dir.length();
         let parent_pos = pos[pp];
-        let sets = near_sets(
+        near_sets(
             list,
             input.bounds,
             vmin(vmin(start, x), parent_pos - V3::splat_f(length)),
             vmax(vmax(start, x), parent_pos + V3::splat_f(length)),
             r,
+            near,
         );
-        let cols = input.colliders;
-        x = collide(
-            list,
-            cols,
-            input.bounds,
-            input.reach,
-            &sets,
-            x,
-            Some(start),
-            r,
-            active,
-        );
-
-        let limit = rig.limit_angle[p];
-        if limit > 0.0 {
-            for l in 0..LANES {
-                if active.0[l] == 0 {
-                    continue;
-                }
-                let limited = cone_limit(x.get(l), parent_pos.get(l), anim_dir.get(l), limit);
-                x.set(l, limited);
-            }
-        }
-        if s.planar_constraint != PlanarAxis::None {
-            let n = input.normals[p];
-            x = x - n * (x - parent_pos).dot(n);
-        }
-
+        let near = &*near;
         let fallback = anim_dir.normalize_or(V3::splat(Vec3::Y));
         let restore = |x: V3| parent_pos + (x - parent_pos).normalize_or(fallback) * length;
-        x = restore(x);
-        if !list.is_empty() {
-            let mut open = active;
-            for _ in 0..3 {
-                let y = collide(
-                    list,
-                    cols,
-                    input.bounds,
-                    input.reach,
-                    &sets,
-                    x,
-                    Some(start),
-                    r,
-                    open,
-                );
+        // The step's collisions: the first pass, then (after the cone, the plane and the
+        // length) up to three passes that each restore the length of what they moved and a
+        // last one that does not. One call site, so that the narrow phase is inlined once.
+        let mut open = active;
+        for pass in 0..5 {
+            let y = collide(
+                list,
+                input.colliders,
+                input.bounds,
+                input.shapes,
+                near,
+                x,
+                Some(start),
+                r,
+                open,
+            );
+            if pass == 0 {
+                x = y;
+                let limit = rig.limit_angle[p];
+                if limit > 0.0 {
+                    for l in 0..LANES {
+                        if active.0[l] == 0 {
+                            continue;
+                        }
+                        let limited =
+                            cone_limit(x.get(l), parent_pos.get(l), anim_dir.get(l), limit);
+                        x.set(l, limited);
+                    }
+                }
+                if s.planar_constraint != PlanarAxis::None {
+                    let n = input.normals[p];
+                    x = x - n * (x - parent_pos).dot(n);
+                }
+                x = restore(x);
+                if list.is_empty() {
+                    break;
+                }
+            } else if pass < 4 {
                 open = open.and(differs(y, x));
                 x = V3::select(open, restore(y), x);
                 if !open.any() {
                     break;
                 }
-            }
-            if open.any() {
-                x = collide(
-                    list,
-                    cols,
-                    input.bounds,
-                    input.reach,
-                    &sets,
-                    x,
-                    Some(start),
-                    r,
-                    open,
-                );
+            } else {
+                x = y;
             }
         }
         pos[p] = V3::select(active, x, pos[p]);
@@ -331,9 +409,10 @@ pub(super) fn output_lanes(
     dev: &[V3],
     colliders: &[PlacedCollider],
     bounds: &[Bound],
-    reach: &[Option<f32>],
+    shapes: &[LaneShape],
     out: &mut [V3],
     live: M,
+    near: &mut [M],
 ) {
     let chain = &rig.chains[ci];
     let alpha = F::splat(chain.settings.alpha);
@@ -355,16 +434,18 @@ pub(super) fn output_lanes(
         let restore = |x: V3| from + (x - from).normalize_or(fallback) * length;
         let mut x = restore(t + d);
         let r = rig.radius[p];
-        let sets = near_sets(
+        near_sets(
             list,
             bounds,
             from - V3::splat_f(length),
             from + V3::splat_f(length),
             r,
+            near,
         );
+        let near = &*near;
         let mut open = live;
         for pass in 0..3 {
-            let y = collide(list, colliders, bounds, reach, &sets, x, None, r, open);
+            let y = collide(list, colliders, bounds, shapes, near, x, None, r, open);
             open = open.and(differs(y, x));
             x = V3::select(open, if pass < 2 { restore(y) } else { y }, x);
             if !open.any() {
@@ -372,5 +453,94 @@ pub(super) fn output_lanes(
             }
         }
         out[p] = x;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::collide::{push_out_of_capsule, push_out_of_sphere};
+    use crate::math::Transform;
+    use glam::Quat;
+
+    /// The lanes' contact decision for keep-out spheres and capsules is sound: a lane
+    /// it turns away gets its point back from the scalar narrow phase bit for bit. Steps
+    /// start and end inside, on and outside the shapes, graze them and pass through them;
+    /// both answers must occur often (a decision that always asks, or never, fails).
+    #[test]
+    fn lane_contact_decision_turns_away_only_points_the_narrow_phase_keeps() {
+        let mut rng = SplitMix64::new(5);
+        let mut u = |lo: f32, hi: f32| rng.range_f32(lo, hi);
+        let (mut kept, mut asked, mut moved) = (0, 0, 0);
+        for round in 0..3000 {
+            let capsule = round % 2 == 1;
+            let radius = u(0.01, 0.1);
+            let length = if round % 10 == 1 { 0.0 } else { u(0.0, 0.3) };
+            let r = u(0.0, 0.03);
+            let limit = radius + r;
+            let (mut p, mut q, mut a, mut b, mut c) =
+                (V3::ZERO, V3::ZERO, V3::ZERO, V3::ZERO, V3::ZERO);
+            for l in 0..LANES {
+                let centre = Vec3::new(u(-1.0, 1.0), u(-1.0, 1.0), u(-1.0, 1.0));
+                let rotation =
+                    Quat::from_euler(glam::EulerRot::XYZ, u(-3.0, 3.0), u(-3.0, 3.0), 0.0);
+                let pc = PlacedCollider {
+                    shape: if capsule {
+                        Shape::Capsule { radius, length }
+                    } else {
+                        Shape::Sphere {
+                            radius,
+                            inside: false,
+                        }
+                    },
+                    transform: Transform::from_translation_rotation(centre, rotation),
+                };
+                let mut bound = Bound::ZERO;
+                bound.set(0, &pc);
+                // Points at a distance around the shape's reach, some exactly on it.
+                let reach = limit + 0.5 * length;
+                let dir = Vec3::new(u(-1.0, 1.0), u(-1.0, 1.0), u(-1.0, 1.0)).normalize_or(Vec3::X);
+                let from = centre + dir * u(0.0, 2.0 * reach);
+                let to = match (round + l) % 4 {
+                    0 => from,
+                    1 => centre - dir * u(0.0, 2.0 * reach),
+                    2 => from + Vec3::new(u(-0.05, 0.05), u(-0.05, 0.05), u(-0.05, 0.05)),
+                    _ => centre + (from - centre).normalize_or(Vec3::Y) * limit,
+                };
+                p.set(l, to);
+                q.set(l, from);
+                a.set(l, bound.a.get(0));
+                b.set(l, bound.b.get(0));
+                c.set(l, centre);
+            }
+            let may = if capsule {
+                capsule_may_move(p, q, a, b, limit)
+            } else {
+                sphere_may_move(p, q, c, limit)
+            };
+            for l in 0..LANES {
+                let want = if capsule {
+                    push_out_of_capsule(p.get(l), q.get(l), a.get(l), b.get(l), limit)
+                } else {
+                    push_out_of_sphere(p.get(l), q.get(l), c.get(l), limit)
+                };
+                let same =
+                    want.to_array().map(f32::to_bits) == p.get(l).to_array().map(f32::to_bits);
+                if may.0[l] == 0 {
+                    assert!(
+                        same,
+                        "round {round} lane {l}: turned away, but the narrow phase moves it"
+                    );
+                    kept += 1;
+                } else {
+                    asked += 1;
+                    moved += usize::from(!same);
+                }
+            }
+        }
+        assert!(
+            kept > 2000 && asked > 2000 && moved > 1000,
+            "{kept} {asked} {moved}"
+        );
     }
 }

@@ -289,6 +289,13 @@ impl Div<F> for V3 {
 }
 
 impl V3 {
+    /// Every lane zero.
+    pub const ZERO: V3 = V3 {
+        x: F([0.0; LANES]),
+        y: F([0.0; LANES]),
+        z: F([0.0; LANES]),
+    };
+
     /// Every lane `v`.
     #[inline(always)]
     pub fn splat(v: Vec3) -> V3 {
@@ -842,6 +849,41 @@ pub fn closest_point_on_segment(p: V3, a: V3, b: V3) -> V3 {
     V3::select(len2.le(F::splat(1e-20)), a, a + ab * t)
 }
 
+/// [`crate::math::closest_params_segment_segment`] per lane: every branch computed, the
+/// scalar function's choice made per lane in the same order (both segments degenerate,
+/// the first, the second, then the general case with its two clamps).
+#[inline(always)]
+pub fn closest_params_segment_segment(p1: V3, q1: V3, p2: V3, q2: V3) -> (F, F) {
+    let d1 = q1 - p1;
+    let d2 = q2 - p2;
+    let r = p1 - p2;
+    let a = d1.dot(d1);
+    let e = d2.dot(d2);
+    let f = d2.dot(r);
+    let eps = F::splat(1e-12);
+    let (zero, one) = (F::splat(0.0), F::splat(1.0));
+    let c = d1.dot(r);
+    let b = d1.dot(d2);
+    let denom = a * e - b * b;
+    let s0 = F::select(denom.gt(eps), ((b * f - c * e) / denom).clamp01(), zero);
+    let t0 = (b * s0 + f) / e;
+    let below = t0.lt(zero);
+    let above = t0.gt(one);
+    let s = F::select(
+        below,
+        (-c / a).clamp01(),
+        F::select(above, ((b - c) / a).clamp01(), s0),
+    );
+    let t = F::select(below, zero, F::select(above, one, t0));
+    let a_small = a.le(eps);
+    let e_small = e.le(eps);
+    let s = F::select(e_small, (-c / a).clamp01(), s);
+    let t = F::select(e_small, zero, t);
+    let s = F::select(a_small, zero, s);
+    let t = F::select(a_small, F::select(e_small, zero, (f / e).clamp01()), t);
+    (s, t)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -924,6 +966,48 @@ mod tests {
                 assert_eq!(bits4(arc.get(i)), bits4(rotation_arc(from, p[i])));
             }
         }
+    }
+
+    /// The segment–segment closest parameters per lane against the scalar function, with
+    /// every branch taken: general segments, parallel ones (denominator 0), each segment
+    /// a point, both points, both clamps, NaN input.
+    #[test]
+    fn lane_segment_segment_gives_the_scalar_bits() {
+        use crate::math::closest_params_segment_segment as scalar;
+        let mut r = Rng::new(23);
+        let mut kinds = [0usize; 6];
+        for round in 0..4000 {
+            let mut ends: [[Vec3; 4]; LANES] =
+                std::array::from_fn(|_| std::array::from_fn(|_| rand_vec(&mut r, 1.0)));
+            for (l, e) in ends.iter_mut().enumerate() {
+                match (round + l) % 6 {
+                    0 => e[1] = e[0],
+                    1 => e[3] = e[2],
+                    2 => (e[1], e[3]) = (e[0], e[2]),
+                    3 => e[3] = e[2] + (e[1] - e[0]) * 0.5,
+                    4 if round % 97 == 0 => e[0].x = f32::NAN,
+                    _ => {}
+                }
+                kinds[(round + l) % 6] += 1;
+            }
+            let lane = |k: usize| {
+                let mut v = V3::splat(Vec3::ZERO);
+                for (l, e) in ends.iter().enumerate() {
+                    v.set(l, e[k]);
+                }
+                v
+            };
+            let (s, t) = closest_params_segment_segment(lane(0), lane(1), lane(2), lane(3));
+            for (l, e) in ends.iter().enumerate() {
+                let (ws, wt) = scalar(e[0], e[1], e[2], e[3]);
+                // NaN as NaN (its payload is not part of the promise: the crowd turns
+                // non-finite input away before it reaches a step).
+                let same = |a: f32, b: f32| a.to_bits() == b.to_bits() || a.is_nan() && b.is_nan();
+                assert!(same(s.0[l], ws), "round {round} lane {l} s");
+                assert!(same(t.0[l], wt), "round {round} lane {l} t");
+            }
+        }
+        assert!(kinds.iter().all(|&k| k > 1000));
     }
 
     /// Interpolation as the fixed-step path uses it: glam's slerp (its own acos and sine
