@@ -145,35 +145,32 @@ pub(super) struct LaneStep<'a> {
     pub active: M,
 }
 
-/// `pick(a, b) ? a : b` per component and lane.
-#[inline(always)]
-fn pick(a: V3, b: V3, take_a: impl Fn(f32, f32) -> bool) -> V3 {
-    let f = |a: F, b: F| {
-        F(std::array::from_fn(|i| {
-            if take_a(a.0[i], b.0[i]) {
-                a.0[i]
-            } else {
-                b.0[i]
-            }
-        }))
-    };
-    V3 {
-        x: f(a.x, b.x),
-        y: f(a.y, b.y),
-        z: f(a.z, b.z),
-    }
-}
-
 /// glam's `Vec3::min` per lane (`a < b ? a : b`, glam's NaN rule).
 #[inline(always)]
 fn vmin(a: V3, b: V3) -> V3 {
-    pick(a, b, |a, b| a < b)
+    V3 {
+        x: F::select(a.x.lt(b.x), a.x, b.x),
+        y: F::select(a.y.lt(b.y), a.y, b.y),
+        z: F::select(a.z.lt(b.z), a.z, b.z),
+    }
 }
 
 /// glam's `Vec3::max` per lane (`a > b ? a : b`).
 #[inline(always)]
 fn vmax(a: V3, b: V3) -> V3 {
-    pick(a, b, |a, b| a > b)
+    V3 {
+        x: F::select(a.x.gt(b.x), a.x, b.x),
+        y: F::select(a.y.gt(b.y), a.y, b.y),
+        z: F::select(a.z.gt(b.z), a.z, b.z),
+    }
+}
+
+/// `x` moved onto the sphere of radius `length` about `from`, along `from`→`x` (or
+/// `fallback` when that has no direction): a bone's length restored. A function, not a
+/// closure, so that it is always inlined into the caller's (AVX2) code.
+#[inline(always)]
+fn restore_length(x: V3, from: V3, fallback: V3, length: F) -> V3 {
+    from + (x - from).normalize_or(fallback) * length
 }
 
 /// [`crate::collide::NearSet::of`] per lane, into `near`: member `i` of the list may touch
@@ -341,7 +338,6 @@ pub(super) fn step_lanes(
         );
         let near = &*near;
         let fallback = anim_dir.normalize_or(V3::splat(Vec3::Y));
-        let restore = |x: V3| parent_pos + (x - parent_pos).normalize_or(fallback) * length;
         // The step's collisions: the first pass, then (after the cone, the plane and the
         // length) up to three passes that each restore the length of what they moved and a
         // last one that does not. One call site, so that the narrow phase is inlined once.
@@ -375,13 +371,13 @@ pub(super) fn step_lanes(
                     let n = input.normals[p];
                     x = x - n * (x - parent_pos).dot(n);
                 }
-                x = restore(x);
+                x = restore_length(x, parent_pos, fallback, length);
                 if list.is_empty() {
                     break;
                 }
             } else if pass < 4 {
                 open = open.and(differs(y, x));
-                x = V3::select(open, restore(y), x);
+                x = V3::select(open, restore_length(y, parent_pos, fallback, length), x);
                 if !open.any() {
                     break;
                 }
@@ -431,8 +427,7 @@ pub(super) fn output_lanes(
         let from = out[pp];
         let length = anim.length();
         let fallback = anim.normalize_or(y_axis);
-        let restore = |x: V3| from + (x - from).normalize_or(fallback) * length;
-        let mut x = restore(t + d);
+        let mut x = restore_length(t + d, from, fallback, length);
         let r = rig.radius[p];
         near_sets(
             list,
@@ -447,7 +442,15 @@ pub(super) fn output_lanes(
         for pass in 0..3 {
             let y = collide(list, colliders, bounds, shapes, near, x, None, r, open);
             open = open.and(differs(y, x));
-            x = V3::select(open, if pass < 2 { restore(y) } else { y }, x);
+            x = V3::select(
+                open,
+                if pass < 2 {
+                    restore_length(y, from, fallback, length)
+                } else {
+                    y
+                },
+                x,
+            );
             if !open.any() {
                 break;
             }
