@@ -57,11 +57,19 @@ pub(super) struct LaneShape {
     /// Its bounding radius ([`PlacedCollider::bounding_radius`]; `None`: it acts
     /// everywhere).
     pub reach: Option<f32>,
-    /// The radius of a keep-out sphere or capsule, whose no-contact decision the lanes
-    /// make themselves; `None` for the other shapes (always asked).
-    pub swept: Option<f32>,
-    /// Whether it is a capsule (else a sphere, when `swept`).
-    pub capsule: bool,
+    /// Who decides whether a point touches it.
+    pub decision: Decision,
+}
+
+/// Where a collider's contact decision is made.
+#[derive(Debug, Clone, Copy)]
+pub(super) enum Decision {
+    /// A keep-out sphere of this radius: in lanes ([`sphere_may_move`]).
+    Sphere(f32),
+    /// A capsule of this radius: in lanes ([`capsule_may_move`]).
+    Capsule(f32),
+    /// Any other shape: the scalar narrow phase, for every lane asked.
+    Scalar,
 }
 
 impl LaneShape {
@@ -71,19 +79,15 @@ impl LaneShape {
             transform: crate::math::Transform::IDENTITY,
         }
         .bounding_radius();
-        let (swept, capsule) = match shape {
+        let decision = match shape {
             Shape::Sphere {
                 radius,
                 inside: false,
-            } => (Some(radius), false),
-            Shape::Capsule { radius, .. } => (Some(radius), true),
-            _ => (None, false),
+            } => Decision::Sphere(radius),
+            Shape::Capsule { radius, .. } => Decision::Capsule(radius),
+            _ => Decision::Scalar,
         };
-        LaneShape {
-            reach,
-            swept,
-            capsule,
-        }
+        LaneShape { reach, decision }
     }
 }
 
@@ -248,14 +252,12 @@ fn collide(
                 continue;
             }
         }
-        if let Some(radius) = shape.swept {
-            let limit = radius + r;
-            let may_move = if shape.capsule {
-                capsule_may_move(y, q, bound.a, bound.b, limit)
-            } else {
-                sphere_may_move(y, q, bound.c, limit)
-            };
-            ask = ask.and(may_move);
+        match shape.decision {
+            Decision::Sphere(radius) => ask = ask.and(sphere_may_move(y, q, bound.c, radius + r)),
+            Decision::Capsule(radius) => {
+                ask = ask.and(capsule_may_move(y, q, bound.a, bound.b, radius + r))
+            }
+            Decision::Scalar => {}
         }
         for l in 0..LANES {
             if ask.0[l] != 0 {
