@@ -1,7 +1,7 @@
 //! Per-character cloth state and the frame job.
 
 use super::compile::{ClothRig, ConstraintKind};
-use super::contact::{core, push_segment, push_triangle};
+use super::contact::{push_segment, push_triangle_against, Core};
 use crate::collide::PlacedCollider;
 use crate::controller::Level;
 use crate::dynamics::path::CharacterPath;
@@ -41,6 +41,9 @@ pub struct ClothState {
     rng: Vec<SplitMix64>,
     needs_reset: Vec<bool>,
     resets: u64,
+    /// Scratch: each of a cloth's colliders as a core segment, slot by slot, for one
+    /// `collide` call.
+    cores: Vec<Option<Core>>,
 }
 
 impl ClothState {
@@ -84,6 +87,7 @@ impl ClothState {
                 .collect(),
             needs_reset: vec![true; rig.cloths.len()],
             resets: 0,
+            cores: Vec::new(),
         }
     }
 
@@ -332,6 +336,7 @@ fn run_cloth(
             None,
             None,
             false,
+            &mut state.cores,
         );
         if let Some(level) = level {
             let (free, radius) = (|p: usize| !rig.fixed[p], |p: usize| rig.radius[p]);
@@ -399,6 +404,10 @@ fn step(rig: &ClothRig, ci: usize, state: &mut ClothState, h: f32, level: Option
             let (a, b) = (c.a as usize, c.b as usize);
             let wa = if rig.fixed[a] { 0.0 } else { 1.0 };
             let wb = if rig.fixed[b] { 0.0 } else { 1.0 };
+            // The correction is shared among the movable ends (the rig has no constraint
+            // between two fixed points): divided by 1 or 2, written as a product by 1 or
+            // 0.5, which is exact either way (the same bits), without a division.
+            let share = if wa + wb > 1.5 { 0.5 } else { 1.0 };
             let d = state.pos[b] - state.pos[a];
             let len = d.length();
             if len < 1e-9 {
@@ -409,7 +418,7 @@ fn step(rig: &ClothRig, ci: usize, state: &mut ClothState, h: f32, level: Option
             if strength <= 0.0 {
                 continue;
             }
-            let corr = d * (diff / len * strength / (wa + wb));
+            let corr = d * (diff / len * strength * share);
             state.pos[a] += corr * wa;
             state.pos[b] -= corr * wb;
         }
@@ -419,6 +428,7 @@ fn step(rig: &ClothRig, ci: usize, state: &mut ClothState, h: f32, level: Option
             step_colliders,
             sides,
             friction,
+            cores,
             ..
         } = &mut *state;
         collide(
@@ -430,6 +440,7 @@ fn step(rig: &ClothRig, ci: usize, state: &mut ClothState, h: f32, level: Option
             Some((friction, &mut sides[ci])),
             // Quads (the costly test) once per step, in the last iteration.
             it + 1 == s.iterations,
+            cores,
         );
     }
     if s.limit_angle > 0.0 {
@@ -464,7 +475,8 @@ fn step(rig: &ClothRig, ci: usize, state: &mut ClothState, h: f32, level: Option
 /// Keeps every free point, structural segment (if on) and quad (if on) out of the cloth's
 /// colliders. With `prev`, a point that passed through a collider during the step is
 /// caught too. With `contact`, touching points get the cloth's friction and quads use the
-/// side memory. Returns whether anything touched.
+/// side memory. Returns whether anything touched. `cores` is scratch.
+#[allow(clippy::too_many_arguments)]
 fn collide(
     rig: &ClothRig,
     ci: usize,
@@ -473,6 +485,7 @@ fn collide(
     prev: Option<&[Vec3]>,
     mut contact: Option<(&mut [f32], &mut [i8])>,
     surfaces: bool,
+    cores: &mut Vec<Option<Core>>,
 ) -> bool {
     let cloth = &rig.cloths[ci];
     let s = &cloth.settings;
@@ -495,6 +508,10 @@ fn collide(
             }
         }
     }
+    // The colliders' cores (and their boxes) once for the segments and quads below, not
+    // once per pair: the colliders do not move during the call.
+    cores.clear();
+    cores.extend(cloth.colliders.iter().map(|&k| Core::of(&colliders[k])));
     if s.segment_collision {
         for c in &rig.constraints[cloth.constraints.clone()] {
             if !matches!(
@@ -506,27 +523,25 @@ fn collide(
             let (a, b) = (c.a as usize, c.b as usize);
             let r = 0.5 * (rig.radius[a] + rig.radius[b]);
             let (lo, hi) = (pos[a].min(pos[b]), pos[a].max(pos[b]));
-            for &k in &cloth.colliders {
-                if let Some((e0, e1, radius)) = core(&colliders[k]) {
-                    // Quick rejection, exact: boxes around the two segments farther apart
-                    // on some axis than the contact distance (with 1e-4 m to spare for
-                    // rounding) mean the exact test below finds no contact either.
-                    let reach = radius + r + 1e-4;
-                    let gap = (lo - e0.max(e1)).max(e0.min(e1) - hi);
-                    if gap.max_element() > reach {
-                        continue;
-                    }
-                    let (mut pa, mut pb) = (pos[a], pos[b]);
-                    if push_segment(
-                        &mut pa,
-                        &mut pb,
-                        [!rig.fixed[a], !rig.fixed[b]],
-                        (e0, e1, radius + r),
-                    ) {
-                        pos[a] = pa;
-                        pos[b] = pb;
-                        touched = true;
-                    }
+            for core in cores.iter().flatten() {
+                // Quick rejection, exact: boxes around the two segments farther apart
+                // on some axis than the contact distance (with 1e-4 m to spare for
+                // rounding) mean the exact test below finds no contact either.
+                let reach = core.radius + r + 1e-4;
+                let gap = (lo - core.hi).max(core.lo - hi);
+                if gap.max_element() > reach {
+                    continue;
+                }
+                let (mut pa, mut pb) = (pos[a], pos[b]);
+                if push_segment(
+                    &mut pa,
+                    &mut pb,
+                    [!rig.fixed[a], !rig.fixed[b]],
+                    (core.e0, core.e1, core.radius + r),
+                ) {
+                    pos[a] = pa;
+                    pos[b] = pb;
+                    touched = true;
                 }
             }
         }
@@ -537,25 +552,16 @@ fn collide(
             let [q00, q10, q11, q01] = quad.map(|i| i as usize);
             for (ti, [i0, i1, i2]) in [[q00, q10, q11], [q00, q11, q01]].into_iter().enumerate() {
                 let r = (rig.radius[i0] + rig.radius[i1] + rig.radius[i2]) / 3.0;
-                for (slot, &k) in cloth.colliders.iter().enumerate() {
-                    let Some((e0, e1, radius)) = core(&colliders[k]) else {
-                        continue;
-                    };
-                    let (mut a, mut b, mut c) = (pos[i0], pos[i1], pos[i2]);
-                    push_triangle(
-                        [&mut a, &mut b, &mut c],
-                        [!rig.fixed[i0], !rig.fixed[i1], !rig.fixed[i2]],
-                        (e0, e1, radius + r),
-                        s.surface_collision,
-                        &mut sides[(qi * 2 + ti) * m + slot],
-                    );
-                    if a != pos[i0] || b != pos[i1] || c != pos[i2] {
-                        touched = true;
-                    }
-                    pos[i0] = a;
-                    pos[i1] = b;
-                    pos[i2] = c;
-                }
+                let (after, moved) = push_triangle_against(
+                    [pos[i0], pos[i1], pos[i2]],
+                    [!rig.fixed[i0], !rig.fixed[i1], !rig.fixed[i2]],
+                    r,
+                    cores,
+                    s.surface_collision,
+                    &mut sides[(qi * 2 + ti) * m..(qi * 2 + ti + 1) * m],
+                );
+                touched |= moved;
+                [pos[i0], pos[i1], pos[i2]] = after;
             }
         }
     }
