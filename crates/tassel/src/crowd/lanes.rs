@@ -111,6 +111,16 @@ impl F {
         M(r)
     }
 
+    /// `self != o` per lane (IEEE: `-0 == 0`, NaN differs from everything).
+    #[inline(always)]
+    pub fn ne(self, o: F) -> M {
+        let mut r = [0u32; LANES];
+        for i in 0..LANES {
+            r[i] = if self.0[i] != o.0[i] { !0 } else { 0 };
+        }
+        M(r)
+    }
+
     /// `self > o` per lane.
     #[inline(always)]
     pub fn gt(self, o: F) -> M {
@@ -182,7 +192,8 @@ impl M {
     /// Any lane set.
     #[inline(always)]
     pub fn any(self) -> bool {
-        self.0.iter().any(|&b| b != 0)
+        // An OR over the lanes, without a branch per lane (one vector test).
+        self.0.iter().fold(0, |a, &b| a | b) != 0
     }
 
     /// Lane `i` set.
@@ -832,12 +843,9 @@ impl Trs {
 /// Whether two per-lane vectors differ (as `Vec3 != Vec3`: by value, `-0 == 0`).
 #[inline(always)]
 pub fn differs(a: V3, b: V3) -> M {
-    let mut r = [0u32; LANES];
-    for i in 0..LANES {
-        let ne = a.x.0[i] != b.x.0[i] || a.y.0[i] != b.y.0[i] || a.z.0[i] != b.z.0[i];
-        r[i] = if ne { !0 } else { 0 };
-    }
-    M(r)
+    // Per component and then OR-ed, not `||` per lane: the short circuit made a branch per
+    // lane and component out of what is three vector compares.
+    a.x.ne(b.x).or(a.y.ne(b.y)).or(a.z.ne(b.z))
 }
 
 /// [`crate::math::closest_point_on_segment`] per lane.
@@ -1103,5 +1111,39 @@ mod tests {
             assert_eq!(bits4(q.get(i)), bits4(rotation_arc(a, v)), "lane {i}");
         }
         assert_eq!(q.get(1).w, 0.0);
+    }
+
+    /// `differs` and `any` answer as `Vec3 != Vec3` and "some lane": by value (`-0 == 0`),
+    /// NaN differing from itself, a difference in any one component.
+    #[test]
+    fn lane_differs_and_any_answer_as_the_scalar_tests() {
+        let values = [0.0, -0.0, 1.0, f32::NAN, f32::INFINITY, -1e-30];
+        let mut rng = crate::rng::SplitMix64::new(3);
+        let mut pick = || values[(rng.next_u64() % values.len() as u64) as usize];
+        let (mut same, mut differ) = (0, 0);
+        for _ in 0..2000 {
+            let (mut a, mut b) = (V3::ZERO, V3::ZERO);
+            for l in 0..LANES {
+                a.set(l, Vec3::new(pick(), pick(), pick()));
+                let mut v = a.get(l);
+                // Mostly equal vectors, with one component changed now and then.
+                if l % 3 == 0 {
+                    v[(l / 3) % 3] = pick();
+                }
+                b.set(l, v);
+            }
+            let m = differs(a, b);
+            for l in 0..LANES {
+                let want = a.get(l) != b.get(l);
+                assert_eq!(m.get(l), want, "{:?} {:?}", a.get(l), b.get(l));
+                same += usize::from(!want);
+                differ += usize::from(want);
+            }
+            assert_eq!(m.any(), (0..LANES).any(|l| m.get(l)));
+        }
+        assert!(same > 1000 && differ > 1000, "{same} {differ}");
+        let mut one = M::NONE;
+        one.0[7] = !0;
+        assert!(one.any() && !M::NONE.any() && M::ALL.any());
     }
 }
