@@ -22,7 +22,7 @@ use crate::dynamics::chain::{ChainSettings, TimeMode};
 use crate::dynamics::path::CharacterPath;
 use crate::error::{Error, Result};
 use crate::math::Transform;
-use crate::pose::{local_to_model_into, LocalToModelJob};
+use crate::pose::LocalToModelJob;
 use crate::rng::SplitMix64;
 use crate::skeleton::Skeleton;
 use glam::{Quat, Vec3};
@@ -202,6 +202,9 @@ struct Scratch {
     /// Per lane (`n` joints each): the animated locals and models.
     locals: Vec<Transform>,
     models: Vec<Transform>,
+    /// The model pose per joint, all lanes side by side (computed in lanes, then copied
+    /// into `models`).
+    lane_models: Vec<Trs>,
     component: Trs,
     /// This frame's animated targets and planar normals per point, colliders lane after
     /// lane, and the colliders' broad-phase spheres.
@@ -216,6 +219,10 @@ struct Scratch {
     step_colliders: Vec<PlacedCollider>,
     step_bounds: Vec<Bound>,
     step_placed_at: Vec<f32>,
+    /// Each lane's place on its path at the share `path_w` of the frame (bits; NaN: not
+    /// this frame's): the chains of a character mostly step at the same shares.
+    path_w: [f32; LANES],
+    path_at: Trs,
     /// The write-back's model rotations per joint (the rotator joints and their parents).
     rotations: Vec<Q>,
     /// One character's targets and normals, for the scalar code.
@@ -233,6 +240,7 @@ impl Scratch {
         Scratch {
             locals: vec![Transform::IDENTITY; joints * LANES],
             models: vec![Transform::IDENTITY; joints * LANES],
+            lane_models: vec![Trs::splat(&Transform::IDENTITY); joints],
             component: Trs::splat(&Transform::IDENTITY),
             targets: vec![zero; n],
             normals: vec![V3::splat(Vec3::Y); n],
@@ -243,6 +251,8 @@ impl Scratch {
             step_colliders: vec![placeholder(); m * LANES],
             step_bounds: vec![Bound::ZERO; m],
             step_placed_at: vec![f32::NAN; m * LANES],
+            path_w: [f32::NAN; LANES],
+            path_at: Trs::splat(&Transform::IDENTITY),
             rotations: vec![Q::splat(Quat::IDENTITY); joints],
             one_targets: vec![Vec3::ZERO; n],
             one_normals: vec![Vec3::Y; n],
@@ -572,6 +582,58 @@ fn motion(
     out
 }
 
+/// Checks one character's input: the pose's length, finite unit-rotation locals within
+/// the limits, a finite transform within them.
+fn check_pose(sk: &Skeleton, i: usize, pose: &CrowdPose) -> Result<()> {
+    let n = sk.len();
+    if pose.locals.len() != n {
+        return Err(Error::LengthMismatch {
+            what: "crowd character's animated pose",
+            expected: n,
+            got: pose.locals.len(),
+        });
+    }
+    if let Some(j) = pose.locals.iter().position(|t| !t.within_limits()) {
+        return Err(Error::NonFinite(format!(
+            "crowd character {i}: animated pose of joint '{}' is not finite, not a unit \
+             rotation, or lies beyond {:e}",
+            sk.name(j),
+            crate::limits::MAX_COORDINATE
+        )));
+    }
+    if !pose.transform.within_limits() {
+        return Err(Error::NonFinite(format!(
+            "crowd character {i}: transform is not finite or lies beyond {:e}",
+            crate::limits::MAX_COORDINATE
+        )));
+    }
+    Ok(())
+}
+
+/// The model pose of the first `count` lanes from their locals in `s`, into `s.models`:
+/// [`crate::pose::local_to_model_into`] for [`LANES`] characters at once. [`Trs::mul`] is
+/// [`Transform::mul_transform`] operation for operation, so each lane gets the bits the
+/// scalar job gives (the identity above the roots, as there).
+#[inline(always)]
+fn model_pose_lanes(sk: &Skeleton, s: &mut Scratch, count: usize) {
+    let n = sk.len();
+    let root = Trs::splat(&Transform::IDENTITY);
+    for j in 0..n {
+        let mut local = root;
+        for l in 0..count {
+            local.set(l, &s.locals[l * n + j]);
+        }
+        let model = match sk.parent(j) {
+            Some(p) => s.lane_models[p].mul(&local),
+            None => root.mul(&local),
+        };
+        s.lane_models[j] = model;
+        for l in 0..count {
+            s.models[l * n + j] = model.get(l);
+        }
+    }
+}
+
 impl Ctx<'_> {
     /// Checks the group's input and computes its animated targets and colliders into
     /// `scratch`. Touches no state.
@@ -588,44 +650,26 @@ impl Ctx<'_> {
         let (sk, rig) = (self.sk, self.rig);
         let n = sk.len();
         let m = rig.colliders.len();
+        // First each lane's input, checked and copied, up to the first bad one; then the
+        // model pose of those lanes at once; then per lane, in order, the model pose's
+        // check (so the error named is the one the lane-by-lane order meets first) and the
+        // targets and colliders.
+        let mut first_bad = None;
         for lane in 0..pack.count {
             let i = base + lane;
             let pose = input(i);
-            if pose.locals.len() != n {
-                return Err((
-                    lane,
-                    Error::LengthMismatch {
-                        what: "crowd character's animated pose",
-                        expected: n,
-                        got: pose.locals.len(),
-                    },
-                ));
-            }
-            if let Some(j) = pose.locals.iter().position(|t| !t.within_limits()) {
-                return Err((
-                    lane,
-                    Error::NonFinite(format!(
-                        "crowd character {i}: animated pose of joint '{}' is not finite, not a \
-                         unit rotation, or lies beyond {:e}",
-                        sk.name(j),
-                        crate::limits::MAX_COORDINATE
-                    )),
-                ));
-            }
-            if !pose.transform.within_limits() {
-                return Err((
-                    lane,
-                    Error::NonFinite(format!(
-                        "crowd character {i}: transform is not finite or lies beyond {:e}",
-                        crate::limits::MAX_COORDINATE
-                    )),
-                ));
+            if let Err(e) = check_pose(sk, i, &pose) {
+                first_bad = Some((lane, e));
+                break;
             }
             scratch.component.set(lane, &pose.transform);
-            let locals = &mut scratch.locals[lane * n..(lane + 1) * n];
+            scratch.locals[lane * n..(lane + 1) * n].copy_from_slice(pose.locals);
+        }
+        let good = first_bad.as_ref().map_or(pack.count, |(lane, _)| *lane);
+        self.model_pose(scratch, good);
+        for lane in 0..good {
+            let i = base + lane;
             let models = &mut scratch.models[lane * n..(lane + 1) * n];
-            locals.copy_from_slice(pose.locals);
-            local_to_model_into(sk, locals, models);
             if let Some(j) = models.iter().position(|t| !t.is_finite()) {
                 return Err((
                     lane,
@@ -654,7 +698,30 @@ impl Ctx<'_> {
                 b.set(lane, c);
             }
         }
-        Ok(())
+        match first_bad {
+            Some(bad) => Err(bad),
+            None => Ok(()),
+        }
+    }
+
+    /// [`model_pose_lanes`] with AVX2 where the CPU has it (as [`Ctx::step`]).
+    fn model_pose(&self, s: &mut Scratch, count: usize) {
+        #[cfg(target_arch = "x86_64")]
+        if self.avx2 && std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: `model_pose_avx2` only requires the AVX2 instructions, and the CPU
+            // was just checked to have them.
+            #[allow(unsafe_code)]
+            unsafe {
+                return self.model_pose_avx2(s, count);
+            }
+        }
+        model_pose_lanes(self.sk, s, count)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn model_pose_avx2(&self, s: &mut Scratch, count: usize) {
+        model_pose_lanes(self.sk, s, count)
     }
 
     /// One frame of one lane group whose input is in `s`: with AVX2 where the CPU has it,
@@ -688,6 +755,7 @@ impl Ctx<'_> {
             pack.paths[l].push(s.component.get(l), self.dt);
         }
         s.step_placed_at.fill(f32::NAN);
+        s.path_w = [f32::NAN; LANES];
         for ci in 0..rig.chains.len() {
             self.run_chain(ci, pack, s, live);
         }
@@ -979,12 +1047,13 @@ impl Ctx<'_> {
                     }
                 }
             }
-            let mut comp_b = Trs::splat(&Transform::IDENTITY);
             for l in 0..LANES {
-                if active.0[l] != 0 {
-                    comp_b.set(l, &pack.paths[l].at(w.0[l]));
+                if active.0[l] != 0 && s.path_w[l].to_bits() != w.0[l].to_bits() {
+                    s.path_at.set(l, &pack.paths[l].at(w.0[l]));
+                    s.path_w[l] = w.0[l];
                 }
             }
+            let comp_b = Trs::select(active, &s.path_at, &Trs::splat(&Transform::IDENTITY));
             let mo = motion(
                 set,
                 Some(&pack.last_step_component[ci]),

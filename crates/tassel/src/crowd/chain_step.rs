@@ -7,9 +7,7 @@
 //! phase's own contact decision run in lanes; the narrow phase itself is left to the
 //! scalar colliders, asked only for the lanes those leave.
 
-use super::lanes::{
-    closest_params_segment_segment, closest_point_on_segment, differs, F, LANES, M, Q, V3,
-};
+use super::lanes::{closest_params_segment_segment, closest_point_on_segment, F, LANES, M, Q, V3};
 use crate::collide::{entry_radius, PlacedCollider, Shape};
 use crate::dynamics::chain::compile::{ChainRig, NONE};
 use crate::dynamics::chain::step::{cone_limit, pull};
@@ -224,11 +222,14 @@ fn collide(
     prev: Option<V3>,
     r: f32,
     open: M,
-) -> V3 {
+) -> (V3, M) {
     let m = colliders.len() / LANES;
     let mut y = x;
+    // `differs(y, x)`, kept up to date lane by lane where a member moves `y` (the only
+    // place it changes) rather than compared afresh for every member.
+    let mut moved = M::NONE;
     for (i, &c) in list.iter().enumerate() {
-        let mut ask = open.and(near[i].or(differs(y, x)));
+        let mut ask = open.and(near[i].or(moved));
         if !ask.any() {
             continue;
         }
@@ -263,10 +264,11 @@ fn collide(
             if ask.0[l] != 0 {
                 let p = colliders[l * m + c].resolve(y.get(l), q.get(l), r);
                 y.set(l, p);
+                moved.0[l] = if p != x.get(l) { !0 } else { 0 };
             }
         }
     }
-    y
+    (y, moved)
 }
 
 /// Advances the points of chain `ci` by one step in the `input.active` lanes.
@@ -345,7 +347,7 @@ pub(super) fn step_lanes(
         // last one that does not. One call site, so that the narrow phase is inlined once.
         let mut open = active;
         for pass in 0..5 {
-            let y = collide(
+            let (y, moved) = collide(
                 list,
                 input.colliders,
                 input.bounds,
@@ -378,7 +380,7 @@ pub(super) fn step_lanes(
                     break;
                 }
             } else if pass < 4 {
-                open = open.and(differs(y, x));
+                open = open.and(moved);
                 x = V3::select(open, restore_length(y, parent_pos, fallback, length), x);
                 if !open.any() {
                     break;
@@ -442,8 +444,8 @@ pub(super) fn output_lanes(
         let near = &*near;
         let mut open = live;
         for pass in 0..3 {
-            let y = collide(list, colliders, bounds, shapes, near, x, None, r, open);
-            open = open.and(differs(y, x));
+            let (y, moved) = collide(list, colliders, bounds, shapes, near, x, None, r, open);
+            open = open.and(moved);
             x = V3::select(
                 open,
                 if pass < 2 {
