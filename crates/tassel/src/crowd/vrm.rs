@@ -57,6 +57,11 @@ struct Plan {
     link_at: Vec<Option<usize>>,
     /// Slots whose model a link's rotation can change (a link or below one).
     affected: Vec<bool>,
+    /// Slots whose animated model a specification step reads before its update writes
+    /// it, or never writes: every slot not affected, a root link (its own model), a
+    /// centre, a collider's joint, and the ancestors of all these (their models are
+    /// composed from the parent's). The others' animated models are overwritten unread.
+    read_animated: Vec<bool>,
     links: Vec<LinkPlan>,
     colliders: Vec<(usize, VrmShape)>,
 }
@@ -132,16 +137,36 @@ impl Plan {
         for s in 0..joints.len() {
             affected[s] = link_at[s].is_some() || parent[s].is_some_and(|p| affected[p]);
         }
-        let colliders = rig
+        let colliders: Vec<(usize, VrmShape)> = rig
             .colliders
             .iter()
             .map(|&(j, shape)| (slot_of[j], shape))
             .collect();
+        let mut read_animated: Vec<bool> = (0..joints.len())
+            .map(|s| !affected[s] || (link_at[s].is_some() && parent[s].is_none()))
+            .collect();
+        for lp in &links {
+            if let Some(c) = lp.center {
+                read_animated[c] = true;
+            }
+        }
+        for &(slot, _) in &colliders {
+            read_animated[slot] = true;
+        }
+        // Parents come before their children, so one pass from the end reaches the roots.
+        for s in (0..joints.len()).rev() {
+            if read_animated[s] {
+                if let Some(p) = parent[s] {
+                    read_animated[p] = true;
+                }
+            }
+        }
         Ok(Plan {
             joints,
             parent,
             link_at,
             affected,
+            read_animated,
             links,
             colliders,
         })
@@ -893,8 +918,13 @@ impl Ctx<'_> {
             let moved = (comp.t - pack.prev_component.t).length();
             reset = reset.or(moved.gt(F::splat(opts.teleport_distance)));
         }
-        // The animated model pose (as the single-character frame computes it).
+        // The animated model pose (as the single-character frame computes it); where the
+        // specification's update runs, only of the slots it reads before writing them.
+        let updates = !fixed && self.dt > 0.0 && reset != M::ALL;
         for k in 0..plan.joints.len() {
+            if updates && !plan.read_animated[k] {
+                continue;
+            }
             s.models[k] = under(&s.models, plan.parent[k], &s.locals[k]);
         }
         if reset != M::ALL {
