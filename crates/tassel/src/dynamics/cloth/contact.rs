@@ -24,15 +24,15 @@ pub(crate) struct Core {
 impl Core {
     /// The core of `col`, if it has one.
     pub(crate) fn of(col: &PlacedCollider) -> Option<Core> {
-        let t = &col.transform;
+        let c = col.transform.translation;
         let (e0, e1, radius) = match col.shape {
             Shape::Sphere {
                 radius,
                 inside: false,
-            } => (t.translation, t.translation, radius),
+            } => (c, c, radius),
             Shape::Capsule { radius, length } => {
-                let axis = t.rotation * Vec3::Y * (0.5 * length);
-                (t.translation - axis, t.translation + axis, radius)
+                let (a, b) = col.capsule_ends(length);
+                (a, b, radius)
             }
             _ => return None,
         };
@@ -189,10 +189,9 @@ pub(crate) fn push_triangle(
 
 /// Triangle `corners` against each of a cloth's colliders in turn (`cores`, slot by slot;
 /// `None`: a collider without a core), as [`push_triangle`] with the pair's side memory
-/// `sides[slot]`; returns the corners moved and whether any collider changed them (by
-/// `!=`, collider by collider). The triangle's frame is made once and again
-/// only after a collider moved a corner, so the result is that of a frame made afresh
-/// for every collider.
+/// `sides[slot]`. Returns the corners moved and whether any collider changed them (by
+/// `!=`, collider by collider). The triangle's frame is made once, and again only after
+/// a collider moved a corner: the result is that of a frame made afresh per collider.
 pub(crate) fn push_triangle_against(
     mut corners: [Vec3; 3],
     free: [bool; 3],
