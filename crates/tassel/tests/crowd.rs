@@ -314,6 +314,67 @@ fn vrm_crowd_rejects_bad_input_by_character() {
     assert!(crowd.rotation(20, 0).is_none() && crowd.reset(20).is_err());
 }
 
+/// Every kind of bad local the single-character check rejects (not finite, beyond the
+/// coordinate limit, not a unit rotation), on every joint of the skeleton (with joints the
+/// crowd computes and joints it only checks), makes the frame fail naming that character
+/// and that joint; what the check accepts (a rotation slightly off unit) passes.
+#[test]
+fn vrm_crowd_checks_every_joint_of_every_character() {
+    let (sk, bones) = builtin::bench_vrm(3, 4, 2);
+    // An extra joint no spring reads: checked, not computed.
+    let mut b = tassel::SkeletonBuilder::new();
+    for j in 0..sk.len() {
+        b.add(sk.name(j), sk.parent(j), sk.rest()[j]);
+    }
+    let extra = b.add("extra", Some(0), Transform::IDENTITY);
+    let (built, remap) = b.build().unwrap();
+    // Depth-first already: the joints the bones name keep their indices.
+    assert!((0..extra).all(|j| remap[j] == j), "{remap:?}");
+    let extra = remap[extra];
+    let sk = Arc::new(built);
+    let rig = Arc::new(VrmRig::new(&sk, &bones, VrmOptions::spec()).unwrap());
+    let rest = sk.rest().to_vec();
+    type Spoil = fn(&mut Transform);
+    let corrupt: [(&str, Spoil); 5] = [
+        ("NaN translation", |t| t.translation.y = f32::NAN),
+        ("infinite scale", |t| t.scale.z = f32::INFINITY),
+        ("huge translation", |t| t.translation.x = 1e30),
+        ("rotation of length 2", |t| t.rotation *= 2.0),
+        ("NaN rotation", |t| t.rotation.w = f32::NAN),
+    ];
+    let mut crowd = VrmCrowd::new(sk.clone(), rig).unwrap();
+    for _ in 0..11 {
+        crowd.add();
+    }
+    for j in 0..sk.len() {
+        for (what, spoil) in &corrupt {
+            let mut bad = rest.clone();
+            spoil(&mut bad[j]);
+            let err = crowd
+                .frame(1.0 / 60.0, |i| CrowdPose {
+                    transform: Transform::IDENTITY,
+                    locals: if i == 9 { &bad } else { &rest },
+                })
+                .expect_err(&format!("{what} on joint {j} passed"))
+                .to_string();
+            assert!(
+                err.contains("crowd character 9") && err.contains(&format!("'{}'", sk.name(j))),
+                "{what} on joint {j}: {err}"
+            );
+        }
+        // Within the check's tolerance (|len² − 1| ≤ 0.21): accepted.
+        let mut fine = rest.clone();
+        fine[j].rotation *= 1.05;
+        crowd
+            .frame(1.0 / 60.0, |i| CrowdPose {
+                transform: Transform::IDENTITY,
+                locals: if i == 9 { &fine } else { &rest },
+            })
+            .unwrap_or_else(|e| panic!("joint {j}: {e}"));
+    }
+    assert_eq!(sk.name(extra), "extra");
+}
+
 /// Characters removed mid-run (`swap_remove`, the last taking the index) and added again:
 /// everyone left carries on with the bits of their own `CharacterSim`, and a character
 /// added into a freed lane starts afresh.

@@ -9,8 +9,10 @@
 //! narrow phase asks the scalar colliders for the lanes whose point may touch one (see
 //! `chain_step`: the contact decision of spheres and capsules runs in lanes too).
 
+#[cfg(target_arch = "x86_64")]
+use super::avx::Fa;
 use super::chain_step::{output_lanes, step_lanes, Bound, LaneShape, LaneStep};
-use super::lanes::{rotation_arc, Trs, F, LANES, M, Q, V3};
+use super::lanes::{rotation_arc, Lane, Trs, F, LANES, M, Q, V3};
 use super::CrowdPose;
 use crate::collide::PlacedCollider;
 use crate::dynamics::chain::compile::ChainRig;
@@ -615,18 +617,20 @@ fn check_pose(sk: &Skeleton, i: usize, pose: &CrowdPose) -> Result<()> {
 /// [`Transform::mul_transform`] operation for operation, so each lane gets the bits the
 /// scalar job gives (the identity above the roots, as there).
 #[inline(always)]
-fn model_pose_lanes(sk: &Skeleton, s: &mut Scratch, count: usize) {
+fn model_pose_lanes<T: Lane>(sk: &Skeleton, s: &mut Scratch, count: usize) {
     let n = sk.len();
-    let root = Trs::splat(&Transform::IDENTITY);
+    let root = Trs::<F>::splat(&Transform::IDENTITY);
     for j in 0..n {
         let mut local = root;
         for l in 0..count {
             local.set(l, &s.locals[l * n + j]);
         }
+        let local = Trs::<T>::of(&local);
         let model = match sk.parent(j) {
-            Some(p) => s.lane_models[p].mul(&local),
-            None => root.mul(&local),
-        };
+            Some(p) => Trs::<T>::of(&s.lane_models[p]).mul(&local),
+            None => Trs::<T>::splat(&Transform::IDENTITY).mul(&local),
+        }
+        .f();
         s.lane_models[j] = model;
         for l in 0..count {
             s.models[l * n + j] = model.get(l);
@@ -715,18 +719,20 @@ impl Ctx<'_> {
                 return self.model_pose_avx2(s, count);
             }
         }
-        model_pose_lanes(self.sk, s, count)
+        model_pose_lanes::<F>(self.sk, s, count)
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
     fn model_pose_avx2(&self, s: &mut Scratch, count: usize) {
-        model_pose_lanes(self.sk, s, count)
+        // The explicit AVX lane type, only here after the CPU was found to have AVX2.
+        model_pose_lanes::<Fa>(self.sk, s, count)
     }
 
-    /// One frame of one lane group whose input is in `s`: with AVX2 where the CPU has it,
-    /// else with the baseline SSE2. Both compile the same code, whose every operation is
-    /// IEEE-exact per lane, so both give the same bits.
+    /// One frame of one lane group whose input is in `s`: with AVX2 where the CPU has it
+    /// (the steps in the explicit AVX lane type, `crowd/avx.rs`), else over `F` with the
+    /// baseline SSE2. Every lane operation of both is IEEE-exact, so both give the same
+    /// bits.
     fn step(&self, pack: &mut Pack, s: &mut Scratch) {
         #[cfg(target_arch = "x86_64")]
         if self.avx2 && std::arch::is_x86_feature_detected!("avx2") {
@@ -737,18 +743,20 @@ impl Ctx<'_> {
                 return self.step_avx2(pack, s);
             }
         }
-        self.step_lanes(pack, s)
+        self.step_lanes::<F>(pack, s)
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
     fn step_avx2(&self, pack: &mut Pack, s: &mut Scratch) {
-        self.step_lanes(pack, s)
+        // The explicit AVX lane type, only here after the CPU was found to have AVX2.
+        self.step_lanes::<Fa>(pack, s)
     }
 
-    /// One frame of one lane group whose input is in `scratch`.
+    /// One frame of one lane group whose input is in `scratch`; the solver steps
+    /// computed in the lane type `T`.
     #[inline(always)]
-    fn step_lanes(&self, pack: &mut Pack, s: &mut Scratch) {
+    fn step_lanes<T: Lane>(&self, pack: &mut Pack, s: &mut Scratch) {
         let rig = self.rig;
         let live = M::from_bools(std::array::from_fn(|l| l < pack.count));
         for l in 0..pack.count {
@@ -757,7 +765,7 @@ impl Ctx<'_> {
         s.step_placed_at.fill(f32::NAN);
         s.path_w = [f32::NAN; LANES];
         for ci in 0..rig.chains.len() {
-            self.run_chain(ci, pack, s, live);
+            self.run_chain::<T>(ci, pack, s, live);
         }
         pack.prev_targets.copy_from_slice(&s.targets);
         pack.prev_normals.copy_from_slice(&s.normals);
@@ -808,7 +816,7 @@ impl Ctx<'_> {
     }
 
     #[inline(always)]
-    fn run_chain(&self, ci: usize, pack: &mut Pack, s: &mut Scratch, live: M) {
+    fn run_chain<T: Lane>(&self, ci: usize, pack: &mut Pack, s: &mut Scratch, live: M) {
         let rig = self.rig;
         let set = &rig.chains[ci].settings;
         let points = rig.chains[ci].points.clone();
@@ -829,13 +837,13 @@ impl Ctx<'_> {
         }
         let reset = M::from_bools(pack.needs_reset[ci]).and(live);
         if reset.any() {
-            self.reset_chain(ci, pack, s, reset);
+            self.reset_chain::<T>(ci, pack, s, reset);
         }
         let run = live.and(reset.not());
         if run.any() {
             match set.mode {
-                TimeMode::Classic => self.run_classic(ci, pack, s, run),
-                TimeMode::Fixed => self.run_fixed(ci, pack, s, run),
+                TimeMode::Classic => self.run_classic::<T>(ci, pack, s, run),
+                TimeMode::Fixed => self.run_fixed::<T>(ci, pack, s, run),
             }
         }
         // Guard: never let a non-finite value out; start again from the pose instead.
@@ -850,7 +858,7 @@ impl Ctx<'_> {
                     pack.teleports[l] += 1;
                 }
             }
-            self.reset_chain(ci, pack, s, bad);
+            self.reset_chain::<T>(ci, pack, s, bad);
         }
         let w = match set.mode {
             TimeMode::Fixed => {
@@ -876,7 +884,7 @@ impl Ctx<'_> {
 
     /// The chain job's `reset_chain` for the lanes `m`.
     #[inline(always)]
-    fn reset_chain(&self, ci: usize, pack: &mut Pack, s: &mut Scratch, m: M) {
+    fn reset_chain<T: Lane>(&self, ci: usize, pack: &mut Pack, s: &mut Scratch, m: M) {
         let rig = self.rig;
         let set = &rig.chains[ci].settings;
         let points = rig.chains[ci].points.clone();
@@ -922,7 +930,7 @@ impl Ctx<'_> {
                     dt_old: F::splat(h),
                     active: m,
                 };
-                step_lanes(
+                step_lanes::<T>(
                     rig,
                     ci,
                     &input,
@@ -946,7 +954,7 @@ impl Ctx<'_> {
     }
 
     #[inline(always)]
-    fn run_classic(&self, ci: usize, pack: &mut Pack, s: &mut Scratch, run: M) {
+    fn run_classic<T: Lane>(&self, ci: usize, pack: &mut Pack, s: &mut Scratch, run: M) {
         let rig = self.rig;
         let set = &rig.chains[ci].settings;
         let dt = self.dt.min(set.max_delta_time);
@@ -974,7 +982,7 @@ impl Ctx<'_> {
                 dt_old: pack.dt_old[ci],
                 active: run,
             };
-            step_lanes(
+            step_lanes::<T>(
                 rig,
                 ci,
                 &input,
@@ -993,7 +1001,7 @@ impl Ctx<'_> {
     }
 
     #[inline(always)]
-    fn run_fixed(&self, ci: usize, pack: &mut Pack, s: &mut Scratch, run: M) {
+    fn run_fixed<T: Lane>(&self, ci: usize, pack: &mut Pack, s: &mut Scratch, run: M) {
         let rig = self.rig;
         let chain = &rig.chains[ci];
         let set = &chain.settings;
@@ -1077,7 +1085,7 @@ impl Ctx<'_> {
                 dt_old: F::splat(h),
                 active,
             };
-            step_lanes(
+            step_lanes::<T>(
                 rig,
                 ci,
                 &input,

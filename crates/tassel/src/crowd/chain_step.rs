@@ -7,7 +7,9 @@
 //! phase's own contact decision run in lanes; the narrow phase itself is left to the
 //! scalar colliders, asked only for the lanes those leave.
 
-use super::lanes::{closest_params_segment_segment, closest_point_on_segment, F, LANES, M, Q, V3};
+use super::lanes::{
+    closest_params_segment_segment, closest_point_on_segment, Lane, Mask, F, LANES, M, Q, V3,
+};
 use crate::collide::{entry_radius, PlacedCollider, Shape};
 use crate::dynamics::chain::compile::{ChainRig, NONE};
 use crate::dynamics::chain::step::{cone_limit, pull};
@@ -94,14 +96,14 @@ impl LaneShape {
 /// entered the entry surface from outside it, or `p` lies inside `limit`. Every other
 /// lane gets `p` back from it unchanged.
 #[inline(always)]
-fn sphere_may_move(p: V3, prev: V3, center: V3, limit: f32) -> M {
-    let inner2 = F::splat(entry_radius(limit).powi(2));
+fn sphere_may_move<T: Lane>(p: V3<T>, prev: V3<T>, center: V3<T>, limit: f32) -> T::M {
+    let inner2 = T::splat(entry_radius(limit).powi(2));
     let from = prev - center;
     let prev_out = inner2.le(from.dot(from));
     let c = closest_point_on_segment(center, prev, p) - center;
     let entered = prev_out.and(c.dot(c).lt(inner2));
     let d = p - center;
-    entered.or(d.dot(d).lt(F::splat(limit * limit)))
+    entered.or(d.dot(d).lt(T::splat(limit * limit)))
 }
 
 /// The lanes whose point a capsule `a`–`b` may move, as
@@ -109,8 +111,8 @@ fn sphere_may_move(p: V3, prev: V3, center: V3, limit: f32) -> M {
 /// entry surface and its closest approach to the axis is inside it, or `p` lies inside
 /// `limit`.
 #[inline(always)]
-fn capsule_may_move(p: V3, prev: V3, a: V3, b: V3, limit: f32) -> M {
-    let inner = F::splat(entry_radius(limit));
+fn capsule_may_move<T: Lane>(p: V3<T>, prev: V3<T>, a: V3<T>, b: V3<T>, limit: f32) -> T::M {
+    let inner = T::splat(entry_radius(limit));
     let prev_dist = (prev - closest_point_on_segment(prev, a, b)).length();
     let (s, t) = closest_params_segment_segment(prev, p, a, b);
     let on_path = prev + (p - prev) * s;
@@ -118,7 +120,7 @@ fn capsule_may_move(p: V3, prev: V3, a: V3, b: V3, limit: f32) -> M {
     let gap = on_path - on_axis;
     let entered = inner.le(prev_dist).and(gap.dot(gap).lt(inner * inner));
     let d = p - closest_point_on_segment(p, a, b);
-    entered.or(d.dot(d).lt(F::splat(limit * limit)))
+    entered.or(d.dot(d).lt(T::splat(limit * limit)))
 }
 
 /// Everything one lane step reads besides the rig and the points (as
@@ -149,21 +151,21 @@ pub(super) struct LaneStep<'a> {
 
 /// glam's `Vec3::min` per lane (`a < b ? a : b`, glam's NaN rule).
 #[inline(always)]
-fn vmin(a: V3, b: V3) -> V3 {
+fn vmin<T: Lane>(a: V3<T>, b: V3<T>) -> V3<T> {
     V3 {
-        x: F::select(a.x.lt(b.x), a.x, b.x),
-        y: F::select(a.y.lt(b.y), a.y, b.y),
-        z: F::select(a.z.lt(b.z), a.z, b.z),
+        x: T::select(a.x.lt(b.x), a.x, b.x),
+        y: T::select(a.y.lt(b.y), a.y, b.y),
+        z: T::select(a.z.lt(b.z), a.z, b.z),
     }
 }
 
 /// glam's `Vec3::max` per lane (`a > b ? a : b`).
 #[inline(always)]
-fn vmax(a: V3, b: V3) -> V3 {
+fn vmax<T: Lane>(a: V3<T>, b: V3<T>) -> V3<T> {
     V3 {
-        x: F::select(a.x.gt(b.x), a.x, b.x),
-        y: F::select(a.y.gt(b.y), a.y, b.y),
-        z: F::select(a.z.gt(b.z), a.z, b.z),
+        x: T::select(a.x.gt(b.x), a.x, b.x),
+        y: T::select(a.y.gt(b.y), a.y, b.y),
+        z: T::select(a.z.gt(b.z), a.z, b.z),
     }
 }
 
@@ -171,7 +173,7 @@ fn vmax(a: V3, b: V3) -> V3 {
 /// `fallback` when that has no direction): a bone's length restored. A function, not a
 /// closure, so that it is always inlined into the caller's (AVX2) code.
 #[inline(always)]
-fn restore_length(x: V3, from: V3, fallback: V3, length: F) -> V3 {
+fn restore_length<T: Lane>(x: V3<T>, from: V3<T>, fallback: V3<T>, length: T) -> V3<T> {
     from + (x - from).normalize_or(fallback) * length
 }
 
@@ -179,28 +181,36 @@ fn restore_length(x: V3, from: V3, fallback: V3, length: F) -> V3 {
 /// the lane's box `lo`–`hi` for a point of radius `r` in the lanes of `near[i]` (a mask
 /// per member rather than a bit set per lane, so that the narrow phase reads it as is).
 #[inline(always)]
-fn near_sets(list: &[usize], bounds: &[Bound], lo: V3, hi: V3, r: f32, near: &mut [M]) {
+fn near_sets<T: Lane>(
+    list: &[usize],
+    bounds: &[Bound],
+    lo: V3<T>,
+    hi: V3<T>,
+    r: f32,
+    near: &mut [M],
+) {
     // A non-finite box or radius may touch everything, as may members from 64 on.
     let everywhere = if r.is_finite() {
         lo.finite().and(hi.finite()).not()
     } else {
-        M::ALL
+        <T::M as Mask>::ALL
     };
     // glam's `max_element` of `lo.abs().max(hi.abs())`: max(x, max(y, z)).
     let size = vmax(lo.abs(), hi.abs());
     let yz = vmax(V3::splat_f(size.y), V3::splat_f(size.z)).x;
     let largest = vmax(V3::splat_f(size.x), V3::splat_f(yz)).x;
-    let extra = F::splat(r) + F::splat(1e-5) * (largest + F::splat(r));
+    let extra = T::splat(r) + T::splat(1e-5) * (largest + T::splat(r));
     let zero = V3::splat(Vec3::ZERO);
     for (i, (&k, out)) in list.iter().zip(near.iter_mut()).enumerate() {
         if i >= 64 {
             *out = M::ALL;
             continue;
         }
-        let b = bounds[k];
-        let d = vmax(vmax(lo - b.c, b.c - hi), zero);
-        let reach = b.w + extra;
-        *out = d.dot(d).le(reach * reach).or(everywhere);
+        let b = &bounds[k];
+        let c = V3::of(b.c);
+        let d = vmax(vmax(lo - c, c - hi), zero);
+        let reach = T::of(b.w) + extra;
+        *out = d.dot(d).le(reach * reach).or(everywhere).m();
     }
 }
 
@@ -212,35 +222,36 @@ fn near_sets(list: &[usize], bounds: &[Bound], lo: V3, hi: V3, r: f32, near: &mu
 /// turn away, computed here for all lanes at once with their operations.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-fn collide(
+fn collide<T: Lane>(
     list: &[usize],
     colliders: &[PlacedCollider],
     bounds: &[Bound],
     shapes: &[LaneShape],
     near: &[M],
-    x: V3,
-    prev: Option<V3>,
+    x: V3<T>,
+    prev: Option<V3<T>>,
     r: f32,
-    open: M,
-) -> (V3, M) {
+    open: T::M,
+) -> (V3<T>, T::M) {
     let m = colliders.len() / LANES;
     let mut y = x;
     // `differs(y, x)`, kept up to date lane by lane where a member moves `y` (the only
     // place it changes) rather than compared afresh for every member.
-    let mut moved = M::NONE;
+    let mut moved = <T::M as Mask>::NONE;
     for (i, &c) in list.iter().enumerate() {
-        let mut ask = open.and(near[i].or(moved));
+        let mut ask = open.and(<T::M as Mask>::of(near[i]).or(moved));
         if !ask.any() {
             continue;
         }
         let q = prev.unwrap_or(y);
         let shape = shapes[c];
         let bound = &bounds[c];
+        let bc = V3::of(bound.c);
         if let Some(reach) = shape.reach {
-            let reach = F::splat(reach + r);
+            let reach = T::splat(reach + r);
             let reach2 = reach * reach;
-            let dp = y - bound.c;
-            let dq = q - bound.c;
+            let dp = y - bc;
+            let dq = q - bc;
             let step = y - q;
             let gap = dp.length() - reach;
             let rejected = dp
@@ -254,27 +265,34 @@ fn collide(
             }
         }
         match shape.decision {
-            Decision::Sphere(radius) => ask = ask.and(sphere_may_move(y, q, bound.c, radius + r)),
+            Decision::Sphere(radius) => ask = ask.and(sphere_may_move(y, q, bc, radius + r)),
             Decision::Capsule(radius) => {
-                ask = ask.and(capsule_may_move(y, q, bound.a, bound.b, radius + r))
+                let (a, b) = (V3::of(bound.a), V3::of(bound.b));
+                ask = ask.and(capsule_may_move(y, q, a, b, radius + r))
             }
             Decision::Scalar => {}
         }
+        // The scalar narrow phase, lane by lane (in `F`, whose lanes are plain memory).
+        let (ask, mut yf, qf, xf) = (ask.m(), y.f(), q.f(), x.f());
+        let mut mv = moved.m();
         for l in 0..LANES {
             if ask.0[l] != 0 {
-                let p = colliders[l * m + c].resolve(y.get(l), q.get(l), r);
-                y.set(l, p);
-                moved.0[l] = if p != x.get(l) { !0 } else { 0 };
+                let p = colliders[l * m + c].resolve(yf.get(l), qf.get(l), r);
+                yf.set(l, p);
+                mv.0[l] = if p != xf.get(l) { !0 } else { 0 };
             }
         }
+        y = V3::of(yf);
+        moved = <T::M as Mask>::of(mv);
     }
     (y, moved)
 }
 
-/// Advances the points of chain `ci` by one step in the `input.active` lanes.
+/// Advances the points of chain `ci` by one step in the `input.active` lanes, computed in
+/// the lane type `T` (the points and the input stay in [`F`]).
 /// `rng` holds the chain's wind generator per lane.
 #[inline(always)]
-pub(super) fn step_lanes(
+pub(super) fn step_lanes<T: Lane>(
     rig: &ChainRig,
     ci: usize,
     input: &LaneStep,
@@ -286,29 +304,34 @@ pub(super) fn step_lanes(
     let chain = &rig.chains[ci];
     let s = &chain.settings;
     let exponent = s.target_framerate * input.dt;
-    let active = input.active;
-    let dt = F::splat(input.dt);
-    let t = input.targets;
+    let active = <T::M as Mask>::of(input.active);
+    let dt = T::splat(input.dt);
+    let t = |p: usize| V3::<T>::of(input.targets[p]);
     let list = &chain.colliders;
-    let has_velocity = input.dt_old.gt(F::splat(0.0));
-    let wind_lanes = input.wind_on.and(active);
-    let wind = input.wind_cs * F::splat(s.wind.speed);
+    let dt_old = T::of(input.dt_old);
+    let has_velocity = dt_old.gt(T::splat(0.0));
+    let wind_lanes = input.wind_on.and(input.active);
+    let wind = V3::<T>::of(input.wind_cs) * T::splat(s.wind.speed);
+    let move_cs = V3::<T>::of(input.move_cs);
+    let rotate_cs = Q::<T>::of(input.rotate_cs);
+    let gravity_step = V3::<T>::of(input.gravity_step);
     for p in chain.points.clone() {
         let parent = rig.parent[p];
+        let (pos_p, prev_p) = (V3::<T>::of(pos[p]), V3::<T>::of(prev[p]));
         if parent == NONE {
-            pos[p] = V3::select(active, t[p], pos[p]);
-            prev[p] = V3::select(active, t[p], prev[p]);
+            pos[p] = V3::select(active, t(p), pos_p).f();
+            prev[p] = V3::select(active, t(p), prev_p).f();
             continue;
         }
         let pp = parent as usize;
 
         let mut velocity = V3::select(
             has_velocity,
-            (pos[p] - prev[p]) / input.dt_old,
+            (pos_p - prev_p) / dt_old,
             V3::splat(Vec3::ZERO),
         );
-        let start = pos[p];
-        velocity = velocity * F::splat(1.0 - rig.damping[p]);
+        let start = pos_p;
+        velocity = velocity * T::splat(1.0 - rig.damping[p]);
         if wind_lanes.any() {
             let mut gust = [0.0f32; LANES];
             for (l, g) in gust.iter_mut().enumerate() {
@@ -316,22 +339,23 @@ pub(super) fn step_lanes(
                     *g = rng[l].range_f32(1.0 - s.wind.gust, 1.0 + s.wind.gust);
                 }
             }
-            let blown = velocity + wind * F(gust) * F::splat(s.target_framerate);
-            velocity = V3::select(wind_lanes, blown, velocity);
+            let blown = velocity + wind * T::of(F(gust)) * T::splat(s.target_framerate);
+            velocity = V3::select(<T::M as Mask>::of(wind_lanes), blown, velocity);
         }
         let mut x = start + velocity * dt;
 
-        x = x + input.move_cs * F::splat(1.0 - rig.wd_location[p]);
-        x = x + (input.rotate_cs.mul_vec3(start) - start) * F::splat(1.0 - rig.wd_rotation[p]);
-        x = x + input.gravity_step;
+        x = x + move_cs * T::splat(1.0 - rig.wd_location[p]);
+        x = x + (rotate_cs.mul_vec3(start) - start) * T::splat(1.0 - rig.wd_rotation[p]);
+        x = x + gravity_step;
 
-        let base = pos[pp] + (t[p] - t[pp]);
-        x = x + (base - x) * F::splat(pull(rig.stiffness[p], exponent));
+        let parent_pos = V3::<T>::of(pos[pp]);
+        let (tp, tpp) = (t(p), t(pp));
+        let base = parent_pos + (tp - tpp);
+        x = x + (base - x) * T::splat(pull(rig.stiffness[p], exponent));
 
         let r = rig.radius[p];
-        let anim_dir = t[p] - t[pp];
+        let anim_dir = tp - tpp;
         let length = anim_dir.length();
-        let parent_pos = pos[pp];
         near_sets(
             list,
             input.bounds,
@@ -362,17 +386,18 @@ pub(super) fn step_lanes(
                 x = y;
                 let limit = rig.limit_angle[p];
                 if limit > 0.0 {
+                    let (mut xf, pf, af) = (x.f(), parent_pos.f(), anim_dir.f());
                     for l in 0..LANES {
-                        if active.0[l] == 0 {
+                        if input.active.0[l] == 0 {
                             continue;
                         }
-                        let limited =
-                            cone_limit(x.get(l), parent_pos.get(l), anim_dir.get(l), limit);
-                        x.set(l, limited);
+                        let limited = cone_limit(xf.get(l), pf.get(l), af.get(l), limit);
+                        xf.set(l, limited);
                     }
+                    x = V3::of(xf);
                 }
                 if s.planar_constraint != PlanarAxis::None {
-                    let n = input.normals[p];
+                    let n = V3::<T>::of(input.normals[p]);
                     x = x - n * (x - parent_pos).dot(n);
                 }
                 x = restore_length(x, parent_pos, fallback, length);
@@ -389,8 +414,8 @@ pub(super) fn step_lanes(
                 x = y;
             }
         }
-        pos[p] = V3::select(active, x, pos[p]);
-        prev[p] = V3::select(active, start, prev[p]);
+        pos[p] = V3::select(active, x, pos_p).f();
+        prev[p] = V3::select(active, start, prev_p).f();
     }
 }
 

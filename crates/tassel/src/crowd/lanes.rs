@@ -4,8 +4,13 @@
 //! Every operation repeats, lane by lane, the exact sequence of IEEE operations that glam
 //! 0.32 (SSE2 build) and [`crate::math`] perform for one character: the same products,
 //! summed in the same order, the same square roots and divisions. That is what lets the
-//! crowd path give the single-character path's results bit for bit. The per-element loops
-//! are left to the compiler to vectorise (plain stable Rust, no `unsafe`).
+//! crowd path give the single-character path's results bit for bit.
+//!
+//! [`V3`], [`Q`] and [`Trs`] are generic over their per-lane type ([`Lane`]): [`F`],
+//! whose per-element loops are left to the compiler to vectorise (plain stable Rust,
+//! every target), and on x86_64 the crowd's private AVX type (`crowd/avx.rs`: one 256-bit
+//! instruction per operation, used inside the crowds' AVX2 functions only). State stays
+//! in [`F`]; `of` and `f` convert (the same bytes).
 
 use crate::math::Transform;
 use glam::{Quat, Vec3};
@@ -208,21 +213,198 @@ impl M {
     }
 }
 
-/// A `Vec3` per lane.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct V3 {
-    /// X per lane.
-    pub x: F,
-    /// Y per lane.
-    pub y: F,
-    /// Z per lane.
-    pub z: F,
+/// What the lane types ([`V3`], [`Q`], [`Trs`]) need of their per-lane `f32`: [`F`]
+/// (plain arrays the compiler vectorises, every target) and, on x86_64, the crowd's AVX
+/// type (explicit 256-bit instructions, used only after the CPU was found to have AVX2).
+/// Every operation is the IEEE operation per lane, so both give the same bits.
+pub trait Lane:
+    Copy
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Div<Output = Self>
+    + Neg<Output = Self>
+{
+    /// The per-lane condition of this type.
+    type M: Mask;
+    /// Every lane `v`.
+    fn splat(v: f32) -> Self;
+    /// From [`F`] (the same lanes).
+    fn of(f: F) -> Self;
+    /// As [`F`] (the same lanes).
+    fn f(self) -> F;
+    /// Lane-wise square root.
+    fn sqrt(self) -> Self;
+    /// `|self|` per lane.
+    fn abs(self) -> Self;
+    /// `self < o` per lane.
+    fn lt(self, o: Self) -> Self::M;
+    /// `self <= o` per lane.
+    fn le(self, o: Self) -> Self::M;
+    /// `self != o` per lane.
+    fn ne(self, o: Self) -> Self::M;
+    /// `self > o` per lane.
+    #[inline(always)]
+    fn gt(self, o: Self) -> Self::M {
+        o.lt(self)
+    }
+    /// Finite per lane.
+    fn finite(self) -> Self::M;
+    /// `m ? a : b` per lane.
+    fn select(m: Self::M, a: Self, b: Self) -> Self;
+    /// `f32::clamp(self, 0, 1)` per lane.
+    #[inline(always)]
+    fn clamp01(self) -> Self {
+        Self::of(self.f().clamp01())
+    }
+    /// `f32::max` per lane.
+    #[inline(always)]
+    fn max(self, o: Self) -> Self {
+        Self::of(self.f().max(o.f()))
+    }
+    /// `f32::signum` per lane.
+    #[inline(always)]
+    fn signum(self) -> Self {
+        Self::of(F(self.f().0.map(f32::signum)))
+    }
+    /// Lane `i`.
+    #[inline(always)]
+    fn get(self, i: usize) -> f32 {
+        self.f().0[i]
+    }
+    /// Sets lane `i`.
+    #[inline(always)]
+    fn set(&mut self, i: usize, v: f32) {
+        let mut f = self.f();
+        f.0[i] = v;
+        *self = Self::of(f);
+    }
 }
 
-impl Add for V3 {
-    type Output = V3;
+/// A per-lane condition of a [`Lane`] type.
+pub trait Mask: Copy + PartialEq {
+    /// No lane.
+    const NONE: Self;
+    /// Every lane.
+    const ALL: Self;
+    /// Both conditions.
+    fn and(self, o: Self) -> Self;
+    /// Either condition.
+    fn or(self, o: Self) -> Self;
+    /// The opposite condition.
+    fn not(self) -> Self;
+    /// Any lane set.
+    fn any(self) -> bool;
+    /// From [`M`] (the same lanes).
+    fn of(m: M) -> Self;
+    /// As [`M`] (the same lanes).
+    fn m(self) -> M;
+}
+
+impl Lane for F {
+    type M = M;
     #[inline(always)]
-    fn add(self, o: V3) -> V3 {
+    fn splat(v: f32) -> F {
+        F::splat(v)
+    }
+    #[inline(always)]
+    fn of(f: F) -> F {
+        f
+    }
+    #[inline(always)]
+    fn f(self) -> F {
+        self
+    }
+    #[inline(always)]
+    fn sqrt(self) -> F {
+        F::sqrt(self)
+    }
+    #[inline(always)]
+    fn abs(self) -> F {
+        F::abs(self)
+    }
+    #[inline(always)]
+    fn lt(self, o: F) -> M {
+        F::lt(self, o)
+    }
+    #[inline(always)]
+    fn le(self, o: F) -> M {
+        F::le(self, o)
+    }
+    #[inline(always)]
+    fn ne(self, o: F) -> M {
+        F::ne(self, o)
+    }
+    #[inline(always)]
+    fn finite(self) -> M {
+        F::finite(self)
+    }
+    #[inline(always)]
+    fn select(m: M, a: F, b: F) -> F {
+        F::select(m, a, b)
+    }
+    #[inline(always)]
+    fn clamp01(self) -> F {
+        F::clamp01(self)
+    }
+    #[inline(always)]
+    fn max(self, o: F) -> F {
+        F::max(self, o)
+    }
+    #[inline(always)]
+    fn get(self, i: usize) -> f32 {
+        self.0[i]
+    }
+    #[inline(always)]
+    fn set(&mut self, i: usize, v: f32) {
+        self.0[i] = v;
+    }
+}
+
+impl Mask for M {
+    const NONE: M = M([0; LANES]);
+    const ALL: M = M([!0; LANES]);
+    #[inline(always)]
+    fn and(self, o: M) -> M {
+        M::and(self, o)
+    }
+    #[inline(always)]
+    fn or(self, o: M) -> M {
+        M::or(self, o)
+    }
+    #[inline(always)]
+    fn not(self) -> M {
+        M::not(self)
+    }
+    #[inline(always)]
+    fn any(self) -> bool {
+        M::any(self)
+    }
+    #[inline(always)]
+    fn of(m: M) -> M {
+        m
+    }
+    #[inline(always)]
+    fn m(self) -> M {
+        self
+    }
+}
+
+/// A `Vec3` per lane.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct V3<T = F> {
+    /// X per lane.
+    pub x: T,
+    /// Y per lane.
+    pub y: T,
+    /// Z per lane.
+    pub z: T,
+}
+
+impl<T: Lane> Add for V3<T> {
+    type Output = V3<T>;
+    #[inline(always)]
+    fn add(self, o: V3<T>) -> V3<T> {
         V3 {
             x: self.x + o.x,
             y: self.y + o.y,
@@ -230,10 +412,10 @@ impl Add for V3 {
         }
     }
 }
-impl Sub for V3 {
-    type Output = V3;
+impl<T: Lane> Sub for V3<T> {
+    type Output = V3<T>;
     #[inline(always)]
-    fn sub(self, o: V3) -> V3 {
+    fn sub(self, o: V3<T>) -> V3<T> {
         V3 {
             x: self.x - o.x,
             y: self.y - o.y,
@@ -241,10 +423,10 @@ impl Sub for V3 {
         }
     }
 }
-impl Neg for V3 {
-    type Output = V3;
+impl<T: Lane> Neg for V3<T> {
+    type Output = V3<T>;
     #[inline(always)]
-    fn neg(self) -> V3 {
+    fn neg(self) -> V3<T> {
         V3 {
             x: -self.x,
             y: -self.y,
@@ -253,10 +435,10 @@ impl Neg for V3 {
     }
 }
 /// Component-wise product.
-impl Mul for V3 {
-    type Output = V3;
+impl<T: Lane> Mul for V3<T> {
+    type Output = V3<T>;
     #[inline(always)]
-    fn mul(self, o: V3) -> V3 {
+    fn mul(self, o: V3<T>) -> V3<T> {
         V3 {
             x: self.x * o.x,
             y: self.y * o.y,
@@ -265,10 +447,10 @@ impl Mul for V3 {
     }
 }
 /// Component-wise quotient.
-impl Div for V3 {
-    type Output = V3;
+impl<T: Lane> Div for V3<T> {
+    type Output = V3<T>;
     #[inline(always)]
-    fn div(self, o: V3) -> V3 {
+    fn div(self, o: V3<T>) -> V3<T> {
         V3 {
             x: self.x / o.x,
             y: self.y / o.y,
@@ -276,10 +458,10 @@ impl Div for V3 {
         }
     }
 }
-impl Mul<F> for V3 {
-    type Output = V3;
+impl<T: Lane> Mul<T> for V3<T> {
+    type Output = V3<T>;
     #[inline(always)]
-    fn mul(self, s: F) -> V3 {
+    fn mul(self, s: T) -> V3<T> {
         V3 {
             x: self.x * s,
             y: self.y * s,
@@ -287,15 +469,103 @@ impl Mul<F> for V3 {
         }
     }
 }
-impl Div<F> for V3 {
-    type Output = V3;
+impl<T: Lane> Div<T> for V3<T> {
+    type Output = V3<T>;
     #[inline(always)]
-    fn div(self, s: F) -> V3 {
+    fn div(self, s: T) -> V3<T> {
         V3 {
             x: self.x / s,
             y: self.y / s,
             z: self.z / s,
         }
+    }
+}
+
+impl<T: Lane> V3<T> {
+    /// Every lane `v`.
+    #[inline(always)]
+    pub fn splat(v: Vec3) -> V3<T> {
+        V3 {
+            x: T::splat(v.x),
+            y: T::splat(v.y),
+            z: T::splat(v.z),
+        }
+    }
+
+    /// glam's `Vec3::dot`: `(x·x' + y·y') + z·z'`.
+    #[inline(always)]
+    pub fn dot(self, o: V3<T>) -> T {
+        self.x * o.x + self.y * o.y + self.z * o.z
+    }
+
+    /// glam's `Vec3::cross`.
+    #[inline(always)]
+    pub fn cross(self, o: V3<T>) -> V3<T> {
+        V3 {
+            x: self.y * o.z - o.y * self.z,
+            y: self.z * o.x - o.z * self.x,
+            z: self.x * o.y - o.x * self.y,
+        }
+    }
+
+    /// glam's `Vec3::length`.
+    #[inline(always)]
+    pub fn length(self) -> T {
+        self.dot(self).sqrt()
+    }
+
+    /// [`crate::math::normalize_or`] per lane.
+    #[inline(always)]
+    pub fn normalize_or(self, fallback: V3<T>) -> V3<T> {
+        let len2 = self.dot(self);
+        let ok = len2.gt(T::splat(1e-20)).and(len2.finite());
+        V3::select(ok, self / len2.sqrt(), fallback)
+    }
+
+    /// Every component `v` (a vector plus or minus a scalar, as glam's `Vec3 ± f32`).
+    #[inline(always)]
+    pub fn splat_f(v: T) -> V3<T> {
+        V3 { x: v, y: v, z: v }
+    }
+
+    /// glam's `Vec3::abs`.
+    #[inline(always)]
+    pub fn abs(self) -> V3<T> {
+        V3 {
+            x: self.x.abs(),
+            y: self.y.abs(),
+            z: self.z.abs(),
+        }
+    }
+
+    /// `m ? a : b` per lane.
+    #[inline(always)]
+    pub fn select(m: T::M, a: V3<T>, b: V3<T>) -> V3<T> {
+        V3 {
+            x: T::select(m, a.x, b.x),
+            y: T::select(m, a.y, b.y),
+            z: T::select(m, a.z, b.z),
+        }
+    }
+
+    /// Finite in every component, per lane.
+    #[inline(always)]
+    pub fn finite(self) -> T::M {
+        self.x.finite().and(self.y.finite()).and(self.z.finite())
+    }
+
+    /// Lane `i`.
+    #[inline(always)]
+    pub fn get(&self, i: usize) -> Vec3 {
+        Vec3::new(self.x.get(i), self.y.get(i), self.z.get(i))
+    }
+
+    /// Sets lane `i`.
+    #[inline(always)]
+    pub fn set(&mut self, i: usize, v: Vec3) {
+        self.x.set(i, v.x);
+        self.y.set(i, v.y);
+        self.z.set(i, v.z);
     }
 }
 
@@ -306,122 +576,36 @@ impl V3 {
         y: F([0.0; LANES]),
         z: F([0.0; LANES]),
     };
-
-    /// Every lane `v`.
-    #[inline(always)]
-    pub fn splat(v: Vec3) -> V3 {
-        V3 {
-            x: F::splat(v.x),
-            y: F::splat(v.y),
-            z: F::splat(v.z),
-        }
-    }
-
-    /// glam's `Vec3::dot`: `(x·x' + y·y') + z·z'`.
-    #[inline(always)]
-    pub fn dot(self, o: V3) -> F {
-        self.x * o.x + self.y * o.y + self.z * o.z
-    }
-
-    /// glam's `Vec3::cross`.
-    #[inline(always)]
-    pub fn cross(self, o: V3) -> V3 {
-        V3 {
-            x: self.y * o.z - o.y * self.z,
-            y: self.z * o.x - o.z * self.x,
-            z: self.x * o.y - o.x * self.y,
-        }
-    }
-
-    /// glam's `Vec3::length`.
-    #[inline(always)]
-    pub fn length(self) -> F {
-        self.dot(self).sqrt()
-    }
-
-    /// [`crate::math::normalize_or`] per lane.
-    #[inline(always)]
-    pub fn normalize_or(self, fallback: V3) -> V3 {
-        let len2 = self.dot(self);
-        let ok = len2.gt(F::splat(1e-20)).and(len2.finite());
-        V3::select(ok, self / len2.sqrt(), fallback)
-    }
-
-    /// Every component `v` (a vector plus or minus a scalar, as glam's `Vec3 ± f32`).
-    #[inline(always)]
-    pub fn splat_f(v: F) -> V3 {
-        V3 { x: v, y: v, z: v }
-    }
-
-    /// glam's `Vec3::abs`.
-    #[inline(always)]
-    pub fn abs(self) -> V3 {
-        V3 {
-            x: self.x.abs(),
-            y: self.y.abs(),
-            z: self.z.abs(),
-        }
-    }
-
-    /// `m ? a : b` per lane.
-    #[inline(always)]
-    pub fn select(m: M, a: V3, b: V3) -> V3 {
-        V3 {
-            x: F::select(m, a.x, b.x),
-            y: F::select(m, a.y, b.y),
-            z: F::select(m, a.z, b.z),
-        }
-    }
-
-    /// Finite in every component, per lane.
-    #[inline(always)]
-    pub fn finite(self) -> M {
-        self.x.finite().and(self.y.finite()).and(self.z.finite())
-    }
-
-    /// Lane `i`.
-    #[inline(always)]
-    pub fn get(&self, i: usize) -> Vec3 {
-        Vec3::new(self.x.0[i], self.y.0[i], self.z.0[i])
-    }
-
-    /// Sets lane `i`.
-    #[inline(always)]
-    pub fn set(&mut self, i: usize, v: Vec3) {
-        self.x.0[i] = v.x;
-        self.y.0[i] = v.y;
-        self.z.0[i] = v.z;
-    }
 }
 
 /// A `Quat` per lane.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Q {
+pub struct Q<T = F> {
     /// X per lane.
-    pub x: F,
+    pub x: T,
     /// Y per lane.
-    pub y: F,
+    pub y: T,
     /// Z per lane.
-    pub z: F,
+    pub z: T,
     /// W per lane.
-    pub w: F,
+    pub w: T,
 }
 
-impl Q {
+impl<T: Lane> Q<T> {
     /// Every lane `q`.
     #[inline(always)]
-    pub fn splat(q: Quat) -> Q {
+    pub fn splat(q: Quat) -> Q<T> {
         Q {
-            x: F::splat(q.x),
-            y: F::splat(q.y),
-            z: F::splat(q.z),
-            w: F::splat(q.w),
+            x: T::splat(q.x),
+            y: T::splat(q.y),
+            z: T::splat(q.z),
+            w: T::splat(q.w),
         }
     }
 
     /// glam's SSE2 `Quat::mul_quat`: `(w·r + x·r_wzyx·±) + (y·r_zwxy·± + z·r_yxwz·±)`.
     #[inline(always)]
-    pub fn mul_quat(self, r: Q) -> Q {
+    pub fn mul_quat(self, r: Q<T>) -> Q<T> {
         let l = self;
         // The four partial products, lane by lane as glam's shuffled vectors hold them.
         let tw = [l.w * r.x, l.w * r.y, l.w * r.z, l.w * r.w];
@@ -440,14 +624,14 @@ impl Q {
     /// glam's SSE2 `Quat::mul_vec3`:
     /// `(v·(w² − b·b) + b·(2(v·b))) + (b × v)·(2w)`.
     #[inline(always)]
-    pub fn mul_vec3(self, v: V3) -> V3 {
+    pub fn mul_vec3(self, v: V3<T>) -> V3<T> {
         let b = V3 {
             x: self.x,
             y: self.y,
             z: self.z,
         };
         let w = self.w;
-        let two = F::splat(2.0);
+        let two = T::splat(2.0);
         let k = w * w - b.dot(b);
         let d2 = v.dot(b) * two;
         let w2 = w * two;
@@ -457,7 +641,7 @@ impl Q {
 
     /// glam's SSE2 `Quat::normalize`: divided by `sqrt((x² + z²) + (y² + w²))`.
     #[inline(always)]
-    pub fn normalize(self) -> Q {
+    pub fn normalize(self) -> Q<T> {
         let len = self.dot(self).sqrt();
         Q {
             x: self.x / len,
@@ -469,13 +653,13 @@ impl Q {
 
     /// glam's SSE2 four-component dot product: `(x·x' + z·z') + (y·y' + w·w')`.
     #[inline(always)]
-    pub fn dot(self, o: Q) -> F {
+    pub fn dot(self, o: Q<T>) -> T {
         (self.x * o.x + self.z * o.z) + (self.y * o.y + self.w * o.w)
     }
 
     /// The conjugate (the inverse of a unit quaternion).
     #[inline(always)]
-    pub fn conjugate(self) -> Q {
+    pub fn conjugate(self) -> Q<T> {
         Q {
             x: -self.x,
             y: -self.y,
@@ -486,18 +670,18 @@ impl Q {
 
     /// `m ? a : b` per lane.
     #[inline(always)]
-    pub fn select(m: M, a: Q, b: Q) -> Q {
+    pub fn select(m: T::M, a: Q<T>, b: Q<T>) -> Q<T> {
         Q {
-            x: F::select(m, a.x, b.x),
-            y: F::select(m, a.y, b.y),
-            z: F::select(m, a.z, b.z),
-            w: F::select(m, a.w, b.w),
+            x: T::select(m, a.x, b.x),
+            y: T::select(m, a.y, b.y),
+            z: T::select(m, a.z, b.z),
+            w: T::select(m, a.w, b.w),
         }
     }
 
     /// Finite in every component, per lane.
     #[inline(always)]
-    pub fn finite(self) -> M {
+    pub fn finite(self) -> T::M {
         self.x
             .finite()
             .and(self.y.finite())
@@ -508,22 +692,22 @@ impl Q {
     /// Lane `i`.
     #[inline(always)]
     pub fn get(&self, i: usize) -> Quat {
-        Quat::from_xyzw(self.x.0[i], self.y.0[i], self.z.0[i], self.w.0[i])
+        Quat::from_xyzw(self.x.get(i), self.y.get(i), self.z.get(i), self.w.get(i))
     }
 
     /// Sets lane `i`.
     #[inline(always)]
     pub fn set(&mut self, i: usize, q: Quat) {
-        self.x.0[i] = q.x;
-        self.y.0[i] = q.y;
-        self.z.0[i] = q.z;
-        self.w.0[i] = q.w;
+        self.x.set(i, q.x);
+        self.y.set(i, q.y);
+        self.z.set(i, q.z);
+        self.w.set(i, q.w);
     }
 }
 
 /// glam's SSE2 `Vec3A::cross` (the same products as `Vec3::cross`, so the same bits).
 #[inline(always)]
-fn sse_cross(a: V3, b: V3) -> V3 {
+fn sse_cross<T: Lane>(a: V3<T>, b: V3<T>) -> V3<T> {
     V3 {
         x: a.y * b.z - b.y * a.z,
         y: a.z * b.x - b.z * a.x,
@@ -533,19 +717,19 @@ fn sse_cross(a: V3, b: V3) -> V3 {
 
 /// A [`Transform`] per lane.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Trs {
+pub struct Trs<T = F> {
     /// Translation.
-    pub t: V3,
+    pub t: V3<T>,
     /// Rotation.
-    pub r: Q,
+    pub r: Q<T>,
     /// Scale.
-    pub s: V3,
+    pub s: V3<T>,
 }
 
-impl Trs {
+impl<T: Lane> Trs<T> {
     /// Every lane `t`.
     #[inline(always)]
-    pub fn splat(t: &Transform) -> Trs {
+    pub fn splat(t: &Transform) -> Trs<T> {
         Trs {
             t: V3::splat(t.translation),
             r: Q::splat(t.rotation),
@@ -555,19 +739,19 @@ impl Trs {
 
     /// [`Transform::transform_point`].
     #[inline(always)]
-    pub fn transform_point(&self, p: V3) -> V3 {
+    pub fn transform_point(&self, p: V3<T>) -> V3<T> {
         self.t + self.r.mul_vec3(self.s * p)
     }
 
     /// [`Transform::inverse_transform_point`].
     #[inline(always)]
-    pub fn inverse_transform_point(&self, p: V3) -> V3 {
+    pub fn inverse_transform_point(&self, p: V3<T>) -> V3<T> {
         self.r.conjugate().mul_vec3(p - self.t) / self.s
     }
 
     /// [`Transform::mul_transform`]: `self * child`.
     #[inline(always)]
-    pub fn mul(&self, child: &Trs) -> Trs {
+    pub fn mul(&self, child: &Trs<T>) -> Trs<T> {
         Trs {
             t: self.transform_point(child.t),
             r: self.r.mul_quat(child.r).normalize(),
@@ -577,7 +761,7 @@ impl Trs {
 
     /// `m ? a : b` per lane.
     #[inline(always)]
-    pub fn select(m: M, a: &Trs, b: &Trs) -> Trs {
+    pub fn select(m: T::M, a: &Trs<T>, b: &Trs<T>) -> Trs<T> {
         Trs {
             t: V3::select(m, a.t, b.t),
             r: Q::select(m, a.r, b.r),
@@ -600,12 +784,80 @@ impl Trs {
     }
 }
 
+impl<T: Lane> V3<T> {
+    /// From [`V3`] over [`F`] (the same lanes).
+    #[inline(always)]
+    pub fn of(v: V3) -> V3<T> {
+        V3 {
+            x: T::of(v.x),
+            y: T::of(v.y),
+            z: T::of(v.z),
+        }
+    }
+
+    /// As [`V3`] over [`F`] (the same lanes).
+    #[inline(always)]
+    pub fn f(self) -> V3 {
+        V3 {
+            x: self.x.f(),
+            y: self.y.f(),
+            z: self.z.f(),
+        }
+    }
+}
+
+impl<T: Lane> Q<T> {
+    /// From [`Q`] over [`F`] (the same lanes).
+    #[inline(always)]
+    pub fn of(q: Q) -> Q<T> {
+        Q {
+            x: T::of(q.x),
+            y: T::of(q.y),
+            z: T::of(q.z),
+            w: T::of(q.w),
+        }
+    }
+
+    /// As [`Q`] over [`F`] (the same lanes).
+    #[inline(always)]
+    pub fn f(self) -> Q {
+        Q {
+            x: self.x.f(),
+            y: self.y.f(),
+            z: self.z.f(),
+            w: self.w.f(),
+        }
+    }
+}
+
+impl<T: Lane> Trs<T> {
+    /// From [`Trs`] over [`F`] (the same lanes).
+    #[inline(always)]
+    pub fn of(t: &Trs) -> Trs<T> {
+        Trs {
+            t: V3::of(t.t),
+            r: Q::of(t.r),
+            s: V3::of(t.s),
+        }
+    }
+
+    /// As [`Trs`] over [`F`] (the same lanes).
+    #[inline(always)]
+    pub fn f(&self) -> Trs {
+        Trs {
+            t: self.t.f(),
+            r: self.r.f(),
+            s: self.s.f(),
+        }
+    }
+}
+
 /// [`crate::math::rotation_arc`] per lane.
 #[inline(always)]
-pub fn rotation_arc(from: V3, to: V3) -> Q {
+pub fn rotation_arc<T: Lane>(from: V3<T>, to: V3<T>) -> Q<T> {
     let a = from.normalize_or(V3::splat(Vec3::Y));
     let b = to.normalize_or(a);
-    let w = F::splat(1.0) + a.dot(b);
+    let w = T::splat(1.0) + a.dot(b);
     let axis = a.any_orthonormal();
     let c = a.cross(b);
     let q = Q {
@@ -619,19 +871,19 @@ pub fn rotation_arc(from: V3, to: V3) -> Q {
         x: axis.x,
         y: axis.y,
         z: axis.z,
-        w: F::splat(0.0),
+        w: T::splat(0.0),
     };
-    Q::select(w.lt(F::splat(1e-7)), half_turn, q)
+    Q::select(w.lt(T::splat(1e-7)), half_turn, q)
 }
 
 /// [`crate::math::rotation_arc`] per lane from a direction shared by all lanes: `a` is
 /// `normalize_or(from, Y)` and `half_turn` its 180° quaternion, both precomputed with the
 /// scalar code.
 #[inline(always)]
-pub fn rotation_arc_from(a: Vec3, half_turn: Quat, to: V3) -> Q {
+pub fn rotation_arc_from<T: Lane>(a: Vec3, half_turn: Quat, to: V3<T>) -> Q<T> {
     let av = V3::splat(a);
     let b = to.normalize_or(av);
-    let w = F::splat(1.0) + av.dot(b);
+    let w = T::splat(1.0) + av.dot(b);
     let c = av.cross(b);
     let q = Q {
         x: c.x,
@@ -640,7 +892,7 @@ pub fn rotation_arc_from(a: Vec3, half_turn: Quat, to: V3) -> Q {
         w,
     }
     .normalize();
-    Q::select(w.lt(F::splat(1e-7)), Q::splat(half_turn), q)
+    Q::select(w.lt(T::splat(1e-7)), Q::splat(half_turn), q)
 }
 
 impl F {
@@ -809,16 +1061,14 @@ impl V3 {
     pub fn lerp(self, rhs: V3, s: F) -> V3 {
         self * (F::splat(1.0) - s) + rhs * s
     }
+}
 
+impl<T: Lane> V3<T> {
     /// glam's `Vec3::any_orthonormal_vector` per lane.
     #[inline(always)]
-    pub fn any_orthonormal(self) -> V3 {
-        let mut sign = [0.0f32; LANES];
-        for i in 0..LANES {
-            sign[i] = self.z.0[i].signum();
-        }
-        let sign = F(sign);
-        let a = F::splat(-1.0) / (sign + self.z);
+    pub fn any_orthonormal(self) -> V3<T> {
+        let sign = self.z.signum();
+        let a = T::splat(-1.0) / (sign + self.z);
         let b = self.x * self.y * a;
         V3 {
             x: b,
@@ -842,7 +1092,7 @@ impl Trs {
 
 /// Whether two per-lane vectors differ (as `Vec3 != Vec3`: by value, `-0 == 0`).
 #[inline(always)]
-pub fn differs(a: V3, b: V3) -> M {
+pub fn differs<T: Lane>(a: V3<T>, b: V3<T>) -> T::M {
     // Per component and then OR-ed, not `||` per lane: the short circuit made a branch per
     // lane and component out of what is three vector compares.
     a.x.ne(b.x).or(a.y.ne(b.y)).or(a.z.ne(b.z))
@@ -850,45 +1100,50 @@ pub fn differs(a: V3, b: V3) -> M {
 
 /// [`crate::math::closest_point_on_segment`] per lane.
 #[inline(always)]
-pub fn closest_point_on_segment(p: V3, a: V3, b: V3) -> V3 {
+pub fn closest_point_on_segment<T: Lane>(p: V3<T>, a: V3<T>, b: V3<T>) -> V3<T> {
     let ab = b - a;
     let len2 = ab.dot(ab);
     let t = ((p - a).dot(ab) / len2).clamp01();
-    V3::select(len2.le(F::splat(1e-20)), a, a + ab * t)
+    V3::select(len2.le(T::splat(1e-20)), a, a + ab * t)
 }
 
 /// [`crate::math::closest_params_segment_segment`] per lane: every branch computed, the
 /// scalar function's choice made per lane in the same order (both segments degenerate,
 /// the first, the second, then the general case with its two clamps).
 #[inline(always)]
-pub fn closest_params_segment_segment(p1: V3, q1: V3, p2: V3, q2: V3) -> (F, F) {
+pub fn closest_params_segment_segment<T: Lane>(
+    p1: V3<T>,
+    q1: V3<T>,
+    p2: V3<T>,
+    q2: V3<T>,
+) -> (T, T) {
     let d1 = q1 - p1;
     let d2 = q2 - p2;
     let r = p1 - p2;
     let a = d1.dot(d1);
     let e = d2.dot(d2);
     let f = d2.dot(r);
-    let eps = F::splat(1e-12);
-    let (zero, one) = (F::splat(0.0), F::splat(1.0));
+    let eps = T::splat(1e-12);
+    let (zero, one) = (T::splat(0.0), T::splat(1.0));
     let c = d1.dot(r);
     let b = d1.dot(d2);
     let denom = a * e - b * b;
-    let s0 = F::select(denom.gt(eps), ((b * f - c * e) / denom).clamp01(), zero);
+    let s0 = T::select(denom.gt(eps), ((b * f - c * e) / denom).clamp01(), zero);
     let t0 = (b * s0 + f) / e;
     let below = t0.lt(zero);
     let above = t0.gt(one);
-    let s = F::select(
+    let s = T::select(
         below,
         (-c / a).clamp01(),
-        F::select(above, ((b - c) / a).clamp01(), s0),
+        T::select(above, ((b - c) / a).clamp01(), s0),
     );
-    let t = F::select(below, zero, F::select(above, one, t0));
+    let t = T::select(below, zero, T::select(above, one, t0));
     let a_small = a.le(eps);
     let e_small = e.le(eps);
-    let s = F::select(e_small, (-c / a).clamp01(), s);
-    let t = F::select(e_small, zero, t);
-    let s = F::select(a_small, zero, s);
-    let t = F::select(a_small, F::select(e_small, zero, (f / e).clamp01()), t);
+    let s = T::select(e_small, (-c / a).clamp01(), s);
+    let t = T::select(e_small, zero, t);
+    let s = T::select(a_small, zero, s);
+    let t = T::select(a_small, T::select(e_small, zero, (f / e).clamp01()), t);
     (s, t)
 }
 
@@ -937,7 +1192,7 @@ mod tests {
             let ta: [Transform; LANES] = std::array::from_fn(|_| rand_transform(&mut r));
             let tb: [Transform; LANES] = std::array::from_fn(|_| rand_transform(&mut r));
             let p: [Vec3; LANES] = std::array::from_fn(|_| rand_vec(&mut r, 2.0));
-            let mut la = Trs::splat(&Transform::IDENTITY);
+            let mut la = Trs::<F>::splat(&Transform::IDENTITY);
             let mut lb = la;
             let mut lp = V3::splat(Vec3::ZERO);
             for i in 0..LANES {
@@ -999,7 +1254,7 @@ mod tests {
                 kinds[(round + l) % 6] += 1;
             }
             let lane = |k: usize| {
-                let mut v = V3::splat(Vec3::ZERO);
+                let mut v = V3::<F>::splat(Vec3::ZERO);
                 for (l, e) in ends.iter().enumerate() {
                     v.set(l, e[k]);
                 }
@@ -1094,7 +1349,7 @@ mod tests {
         let a = Vec3::Y;
         let o = a.any_orthonormal_vector();
         let half = Quat::from_xyzw(o.x, o.y, o.z, 0.0);
-        let mut to = V3::splat(Vec3::new(0.3, 0.2, 0.1));
+        let mut to = V3::<F>::splat(Vec3::new(0.3, 0.2, 0.1));
         to.set(1, -Vec3::Y);
         to.set(2, Vec3::ZERO);
         to.set(3, Vec3::new(f32::NAN, 0.0, 0.0));

@@ -10,6 +10,8 @@
 //! - [`VrmCrowd`]: VRM spring bones (`fixed`, `spec` and `three-vrm` modes).
 //! - [`ChainCrowd`]: bone chains (both time modes, every collider shape).
 
+#[cfg(target_arch = "x86_64")]
+mod avx;
 mod chain;
 mod chain_step;
 pub mod lanes;

@@ -7,7 +7,11 @@
 //! tails) is the same for all lanes. Branches that depend on a character's state (a
 //! contact, a fallback, a reset) are computed for every lane and selected per lane.
 
-use super::lanes::{closest_point_on_segment, differs, rotation_arc_from, Trs, F, LANES, M, Q, V3};
+#[cfg(target_arch = "x86_64")]
+use super::avx::Fa;
+use super::lanes::{
+    closest_point_on_segment, differs, rotation_arc_from, Lane, Mask, Trs, F, LANES, M, Q, V3,
+};
 use crate::dynamics::path::CharacterPath;
 use crate::dynamics::vrm::{VrmMode, VrmRig, VrmShape};
 use crate::error::{Error, Result};
@@ -62,6 +66,8 @@ struct Plan {
     /// centre, a collider's joint, and the ancestors of all these (their models are
     /// composed from the parent's). The others' animated models are overwritten unread.
     read_animated: Vec<bool>,
+    /// Skeleton joints not in `joints` (their input is checked, not used).
+    unplanned: Vec<usize>,
     links: Vec<LinkPlan>,
     colliders: Vec<(usize, VrmShape)>,
 }
@@ -93,6 +99,7 @@ impl Plan {
             mark(*j, &mut needed);
         }
         let joints: Vec<usize> = (0..n).filter(|&j| needed[j]).collect();
+        let unplanned: Vec<usize> = (0..n).filter(|&j| !needed[j]).collect();
         let mut slot_of = vec![usize::MAX; n];
         for (s, &j) in joints.iter().enumerate() {
             slot_of[j] = s;
@@ -167,6 +174,7 @@ impl Plan {
             link_at,
             affected,
             read_animated,
+            unplanned,
             links,
             colliders,
         })
@@ -227,11 +235,33 @@ impl Pack {
 /// `b` (capsule tail, plane normal), with a bounding sphere for the quick rejection: every
 /// point of a sphere or capsule's axis lies within `half` of `mid`.
 #[derive(Debug, Clone, Copy)]
-struct Placed {
-    a: V3,
-    b: V3,
-    mid: V3,
-    half: F,
+struct Placed<T = F> {
+    a: V3<T>,
+    b: V3<T>,
+    mid: V3<T>,
+    half: T,
+}
+
+impl<T: Lane> Placed<T> {
+    #[inline(always)]
+    fn of(p: &Placed) -> Placed<T> {
+        Placed {
+            a: V3::of(p.a),
+            b: V3::of(p.b),
+            mid: V3::of(p.mid),
+            half: T::of(p.half),
+        }
+    }
+
+    #[inline(always)]
+    fn f(&self) -> Placed {
+        Placed {
+            a: self.a.f(),
+            b: self.b.f(),
+            mid: self.mid.f(),
+            half: self.half.f(),
+        }
+    }
 }
 
 /// One character's state, taken out of its lane (to move it to another).
@@ -620,10 +650,7 @@ impl VrmCrowd {
             .for_each(|(c, (packs, scratch))| {
                 for (k, pack) in packs.iter_mut().enumerate() {
                     let base = (c * chunk + k) * LANES;
-                    pack.error = ctx.gather(pack, scratch, base, input).err();
-                    if pack.error.is_none() {
-                        ctx.step(pack, scratch);
-                    }
+                    pack.error = ctx.run(pack, scratch, base, input).err();
                 }
             });
         match self.packs.iter().find_map(|p| p.error.clone()) {
@@ -645,9 +672,133 @@ struct Ctx<'c> {
 }
 
 impl Ctx<'_> {
+    /// Loads, checks and steps one lane group: with AVX2 where the CPU has it, in the
+    /// explicit AVX lane type (`crowd/avx.rs`; 1.2x faster than the same code over `F`
+    /// compiled for AVX2, which was 1.5x faster than SSE2: `tassel bench --crowd 200
+    /// --vrm spec`), else over `F` with the baseline SSE2. Every lane operation of both
+    /// is IEEE-exact, so both give the same bits.
+    fn run<'a, I>(
+        &self,
+        pack: &mut Pack,
+        scratch: &mut Scratch,
+        base: usize,
+        input: &I,
+    ) -> std::result::Result<(), (usize, Error)>
+    where
+        I: Fn(usize) -> CrowdPose<'a> + Sync,
+    {
+        #[cfg(target_arch = "x86_64")]
+        if self.avx2 && std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: `run_avx2` only requires the AVX2 instructions, and the CPU was
+            // just checked to have them.
+            #[allow(unsafe_code)]
+            unsafe {
+                return self.run_avx2(pack, scratch, base, input);
+            }
+        }
+        self.gather::<F, I>(pack, scratch, base, input)?;
+        self.step_baseline(pack, scratch);
+        Ok(())
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn run_avx2<'a, I>(
+        &self,
+        pack: &mut Pack,
+        scratch: &mut Scratch,
+        base: usize,
+        input: &I,
+    ) -> std::result::Result<(), (usize, Error)>
+    where
+        I: Fn(usize) -> CrowdPose<'a> + Sync,
+    {
+        // The explicit AVX lane type only inside this function, after the CPU was
+        // found to have AVX2 (the condition of its soundness).
+        self.gather::<Fa, I>(pack, scratch, base, input)?;
+        self.step_avx2(pack, scratch);
+        Ok(())
+    }
+
+    // The step itself is not generic over the input: compiled once, here, rather than
+    // inlined into every caller's `frame` (a whole step per closure type).
+    #[inline(never)]
+    fn step_baseline(&self, pack: &mut Pack, s: &mut Scratch) {
+        self.step_lanes::<F>(pack, s)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    #[inline(never)]
+    fn step_avx2(&self, pack: &mut Pack, s: &mut Scratch) {
+        self.step_lanes::<Fa>(pack, s)
+    }
+
+    /// [`Ctx::gather_checked`]'s result, faster where the input is good and no
+    /// constraint applies: the poses are transposed into lanes first and checked there,
+    /// eight characters per operation. Any failed check (or constraints) runs
+    /// `gather_checked` itself, so the error is the same.
+    #[inline(always)]
+    fn gather<'a, T: Lane, I>(
+        &self,
+        pack: &mut Pack,
+        scratch: &mut Scratch,
+        base: usize,
+        input: &I,
+    ) -> std::result::Result<(), (usize, Error)>
+    where
+        I: Fn(usize) -> CrowdPose<'a> + Sync,
+    {
+        let sk = self.sk;
+        let n = sk.len();
+        if !self.rig.constraints.list.is_empty() {
+            return self.gather_checked(pack, scratch, base, input);
+        }
+        let rest: &[Transform] = sk.rest();
+        let mut poses = [rest; LANES];
+        let mut component = Trs::splat(&Transform::IDENTITY);
+        let used = pack.count.min(LANES);
+        for (lane, slot) in poses.iter_mut().enumerate().take(used) {
+            let pose = input(base + lane);
+            if pose.locals.len() != n || !pose.transform.within_limits() {
+                return self.gather_checked(pack, scratch, base, input);
+            }
+            *slot = pose.locals;
+            component.set(lane, &pose.transform);
+        }
+        let mut ok = <T::M as Mask>::of(M::from_bools(std::array::from_fn(|l| l >= used)));
+        let mut all = <T::M as Mask>::NONE.not();
+        for (s, &j) in self.plan.joints.iter().enumerate() {
+            let locals = &mut scratch.locals[s];
+            for (lane, pose) in poses.iter().enumerate() {
+                locals.set(lane, &pose[j]);
+            }
+        }
+        // Checked in a pass of its own: a vector load right after the eight lane stores
+        // that wrote it waits for them to reach the cache (no store forwarding), which
+        // cost a tenth of the frame when the check followed each slot's transposition.
+        for locals in &scratch.locals {
+            all = all.and(within_limits(&Trs::<T>::of(locals)));
+        }
+        ok = ok.or(all);
+        let mut fine = ok == <T::M as Mask>::ALL;
+        for pose in &poses[..used] {
+            for &j in &self.plan.unplanned {
+                fine &= pose[j].within_limits();
+            }
+        }
+        if !fine {
+            return self.gather_checked(pack, scratch, base, input);
+        }
+        scratch.component = component;
+        Ok(())
+    }
+
     /// Checks the group's input and loads it into `scratch.locals` and
-    /// `scratch.component`; unused lanes get the rest pose. Touches no state.
-    fn gather<'a, I>(
+    /// `scratch.component`; unused lanes get the rest pose. Touches no state. Lane by
+    /// lane, the first bad input of the first bad lane is the error: the reference for
+    /// [`Ctx::gather`], which it runs where constraints change the pose or a check failed.
+    fn gather_checked<'a, I>(
         &self,
         pack: &mut Pack,
         scratch: &mut Scratch,
@@ -734,13 +885,29 @@ impl Ctx<'_> {
     }
 }
 
+/// [`Transform::within_limits`] per lane (the same operations: glam's four-component dot
+/// for the rotation's squared length).
+#[inline(always)]
+fn within_limits<T: Lane>(t: &Trs<T>) -> T::M {
+    let max = T::splat(crate::limits::MAX_COORDINATE);
+    let unit = (t.r.dot(t.r) - T::splat(1.0)).abs().le(T::splat(0.21));
+    let (a, s) = (t.t.abs(), t.s.abs());
+    unit.and(a.x.le(max))
+        .and(a.y.le(max))
+        .and(a.z.le(max))
+        .and(s.x.le(max))
+        .and(s.y.le(max))
+        .and(s.z.le(max))
+}
+
 /// The model transform of a slot with `local` under its parent's model in `models`
 /// (`None`: a skeleton root, under the identity as [`LocalToModelJob`] puts it).
 #[inline(always)]
-fn under(models: &[Trs], parent: Option<usize>, local: &Trs) -> Trs {
+fn under<T: Lane>(models: &[Trs], parent: Option<usize>, local: &Trs) -> Trs<T> {
+    let local = Trs::<T>::of(local);
     match parent {
-        Some(p) => models[p].mul(local),
-        None => Trs::splat(&Transform::IDENTITY).mul(local),
+        Some(p) => Trs::<T>::of(&models[p]).mul(&local),
+        None => Trs::<T>::splat(&Transform::IDENTITY).mul(&local),
     }
 }
 
@@ -751,23 +918,23 @@ fn under(models: &[Trs], parent: Option<usize>, local: &Trs) -> Trs {
 /// The early `None` compares against a bounding sphere rounded outward, so it only ever
 /// skips what the exact test would find out of contact: the results keep the scalar bits.
 #[inline(always)]
-fn distance(shape: &VrmShape, placed: &Placed, p: V3, r: f32) -> Option<(F, V3)> {
-    let zero = F::splat(0.0);
+fn distance<T: Lane>(shape: &VrmShape, placed: &Placed<T>, p: V3<T>, r: f32) -> Option<(T, V3<T>)> {
+    let zero = T::splat(0.0);
     let (radius, inside) = match *shape {
         VrmShape::Sphere { radius, inside, .. } | VrmShape::Capsule { radius, inside, .. } => {
             (radius, inside)
         }
         VrmShape::Plane { .. } => {
-            return Some(((p - placed.a).dot(placed.b) - F::splat(r), placed.b));
+            return Some(((p - placed.a).dot(placed.b) - T::splat(r), placed.b));
         }
     };
     if !inside {
         // Certainly out of reach: farther from the bounding sphere's centre than its
         // radius plus the contact distance, with 1e-4 to spare for the rounding of these
         // few operations (so that no lane the exact test would push is skipped).
-        let reach = (placed.half + F::splat(radius + r)) * F::splat(1.0001) + F::splat(1e-6);
+        let reach = (placed.half + T::splat(radius + r)) * T::splat(1.0001) + T::splat(1e-6);
         let far = (p - placed.mid).dot(p - placed.mid).gt(reach * reach);
-        if far == M::ALL {
+        if far == <T::M as Mask>::ALL {
             return None;
         }
     }
@@ -786,9 +953,9 @@ fn distance(shape: &VrmShape, placed: &Placed, p: V3, r: f32) -> Option<(F, V3)>
     };
     let len = delta.length();
     Some(if inside {
-        (F::splat(radius - r) - len, delta)
+        (T::splat(radius - r) - len, delta)
     } else {
-        (len - F::splat(radius + r), delta)
+        (len - T::splat(radius + r), delta)
     })
 }
 
@@ -796,9 +963,14 @@ fn distance(shape: &VrmShape, placed: &Placed, p: V3, r: f32) -> Option<(F, V3)>
 /// direction, the signed distance and the lanes in contact. The direction (three
 /// divisions and a square root) is computed only when a lane is in contact.
 #[inline(always)]
-fn contact(shape: &VrmShape, placed: &Placed, p: V3, r: f32) -> Option<(V3, F, M)> {
+fn contact<T: Lane>(
+    shape: &VrmShape,
+    placed: &Placed<T>,
+    p: V3<T>,
+    r: f32,
+) -> Option<(V3<T>, T, T::M)> {
     let (dist, delta) = distance(shape, placed, p, r)?;
-    let hit = dist.lt(F::splat(0.0));
+    let hit = dist.lt(T::splat(0.0));
     if !hit.any() {
         return None;
     }
@@ -819,20 +991,27 @@ fn contact(shape: &VrmShape, placed: &Placed, p: V3, r: f32) -> Option<(V3, F, M
 /// How far a tail at `p` violates the collider, per lane (≤ 0: not at all), or `None` when
 /// no lane can.
 #[inline(always)]
-fn penetration(shape: &VrmShape, placed: &Placed, p: V3, r: f32) -> Option<F> {
+fn penetration<T: Lane>(shape: &VrmShape, placed: &Placed<T>, p: V3<T>, r: f32) -> Option<T> {
     distance(shape, placed, p, r).map(|(d, _)| -d)
 }
 
 /// [`crate::dynamics::vrm::PlacedVrmCollider::settle`] per lane.
 #[inline(always)]
-fn settle_one(shape: &VrmShape, placed: &Placed, pos: V3, length: F, tail: V3, r: f32) -> V3 {
-    let zero = F::splat(0.0);
-    let one = F::splat(1.0);
+fn settle_one<T: Lane>(
+    shape: &VrmShape,
+    placed: &Placed<T>,
+    pos: V3<T>,
+    length: T,
+    tail: V3<T>,
+    r: f32,
+) -> V3<T> {
+    let zero = T::splat(0.0);
+    let one = T::splat(1.0);
     let (a, c, valid) = match *shape {
         VrmShape::Plane { .. } => {
             let normal = placed.b;
-            let c = (F::splat(r) - (pos - placed.a).dot(normal)) / length;
-            (normal, c, M::ALL)
+            let c = (T::splat(r) - (pos - placed.a).dot(normal)) / length;
+            (normal, c, <T::M as Mask>::ALL)
         }
         VrmShape::Sphere { radius, inside, .. } | VrmShape::Capsule { radius, inside, .. } => {
             let q = match *shape {
@@ -846,9 +1025,9 @@ fn settle_one(shape: &VrmShape, placed: &Placed, pos: V3, length: F, tail: V3, r
             };
             let d = pos - q;
             let dl = d.length();
-            let k = (F::splat(limit * limit) - dl * dl - length * length)
-                / (F::splat(2.0) * length * dl);
-            let valid = dl.lt(F::splat(1e-9)).not();
+            let k = (T::splat(limit * limit) - dl * dl - length * length)
+                / (T::splat(2.0) * length * dl);
+            let valid = dl.lt(T::splat(1e-9)).not();
             if inside {
                 (-d / dl, -k, valid)
             } else {
@@ -858,18 +1037,18 @@ fn settle_one(shape: &VrmShape, placed: &Placed, pos: V3, length: F, tail: V3, r
     };
     let u = (tail - pos).normalize_or(a);
     let ua = u.dot(a);
-    let keep = (c - F::splat(1e-6)).le(ua).or(c.lt(F::splat(-1.0)));
+    let keep = (c - T::splat(1e-6)).le(ua).or(c.lt(T::splat(-1.0)));
     let straight = pos + a * length;
     let side = (u - a * ua).normalize_or(a.any_orthonormal());
     let turned = pos + (a * c + side * (one - c * c).sqrt()) * length;
-    let moved = V3::select(F::splat(1.0).le(c), straight, turned);
+    let moved = V3::select(T::splat(1.0).le(c), straight, turned);
     let unchanged = length.le(zero).or(valid.not()).or(keep);
     V3::select(unchanged, tail, moved)
 }
 
 /// The joints a frame (or a step) works on: the character transform, locals, models.
-struct Poses<'p> {
-    comp: Trs,
+struct Poses<'p, T = F> {
+    comp: Trs<T>,
     locals: &'p [Trs],
     models: &'p mut [Trs],
 }
@@ -878,31 +1057,10 @@ struct Poses<'p> {
 // compiled without the AVX2 code generation of the function it is called from.
 #[allow(clippy::manual_map)]
 impl Ctx<'_> {
-    /// One frame of one lane group whose input is in `s`: with AVX2 where the CPU has it
-    /// (twice the lanes per instruction: 1.5× faster, `cargo bench -p tassel --bench crowd`),
-    /// else with the baseline SSE2. Both compile the same code, whose every operation is
-    /// IEEE-exact per lane, so both give the same bits.
-    fn step(&self, pack: &mut Pack, s: &mut Scratch) {
-        #[cfg(target_arch = "x86_64")]
-        if self.avx2 && std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: `step_avx2` only requires the AVX2 instructions, and the CPU was
-            // just checked to have them.
-            #[allow(unsafe_code)]
-            unsafe {
-                return self.step_avx2(pack, s);
-            }
-        }
-        self.step_lanes(pack, s)
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    fn step_avx2(&self, pack: &mut Pack, s: &mut Scratch) {
-        self.step_lanes(pack, s)
-    }
-
+    /// One frame of one lane group, its hot part (the model pose, the colliders, the
+    /// specification's update) computed in the lane type `T`.
     #[inline(always)]
-    fn step_lanes(&self, pack: &mut Pack, s: &mut Scratch) {
+    fn step_lanes<T: Lane>(&self, pack: &mut Pack, s: &mut Scratch) {
         let plan = self.plan;
         let opts = &self.rig.options;
         let mode = opts.mode;
@@ -925,11 +1083,11 @@ impl Ctx<'_> {
             if updates && !plan.read_animated[k] {
                 continue;
             }
-            s.models[k] = under(&s.models, plan.parent[k], &s.locals[k]);
+            s.models[k] = under::<T>(&s.models, plan.parent[k], &s.locals[k]).f();
         }
         if reset != M::ALL {
             if fixed {
-                self.run_fixed(pack, s, reset);
+                self.run_fixed::<T>(pack, s, reset);
             } else if self.dt > 0.0 {
                 let Scratch {
                     locals,
@@ -938,23 +1096,22 @@ impl Ctx<'_> {
                     ..
                 } = s;
                 let mut poses = Poses {
-                    comp,
+                    comp: Trs::<T>::of(&comp),
                     locals,
                     models,
                 };
                 self.place_colliders(&poses, placed);
-                self.update(pack, &mut poses, placed, mode, M::ALL);
+                self.update(pack, &mut poses, placed, mode, <T::M as Mask>::ALL);
             }
         }
         // Guard: a non-finite state starts again from the pose.
-        let mut bad = M::NONE;
+        let mut bad = <T::M as Mask>::NONE;
         for i in 0..self.rig.links.len() {
-            bad = bad.or(pack.current_tail[i]
-                .finite()
-                .and(pack.rotation[i].finite())
-                .not());
+            let tail = V3::<T>::of(pack.current_tail[i]);
+            let rotation = Q::<T>::of(pack.rotation[i]);
+            bad = bad.or(tail.finite().and(rotation.finite()).not());
         }
-        let again = reset.or(bad);
+        let again = reset.or(bad.m());
         if again.any() {
             let still_bad = self.reset(pack, s, again);
             for lane in 0..LANES {
@@ -981,12 +1138,12 @@ impl Ctx<'_> {
     }
 
     #[inline(always)]
-    fn place_colliders(&self, poses: &Poses, placed: &mut [Placed]) {
+    fn place_colliders<T: Lane>(&self, poses: &Poses<T>, placed: &mut [Placed]) {
         let comp = poses.comp;
         for (c, (slot, shape)) in self.plan.colliders.iter().enumerate() {
-            let w = comp.mul(&poses.models[*slot]);
+            let w = comp.mul(&Trs::of(&poses.models[*slot]));
             let zero = V3::splat(Vec3::ZERO);
-            let half = F::splat(0.5);
+            let half = T::splat(0.5);
             let (a, b) = match *shape {
                 VrmShape::Sphere { offset, .. } => (w.transform_point(V3::splat(offset)), zero),
                 VrmShape::Capsule { offset, tail, .. } => (
@@ -999,7 +1156,7 @@ impl Ctx<'_> {
                         .normalize_or(V3::splat(Vec3::Y)),
                 ),
             };
-            placed[c] = match *shape {
+            let p: Placed<T> = match *shape {
                 VrmShape::Capsule { .. } => Placed {
                     a,
                     b,
@@ -1010,9 +1167,10 @@ impl Ctx<'_> {
                     a,
                     b,
                     mid: a,
-                    half: F::splat(0.0),
+                    half: T::splat(0.0),
                 },
             };
+            placed[c] = p.f();
         }
     }
 
@@ -1021,13 +1179,13 @@ impl Ctx<'_> {
     /// refreshed skeleton root takes its local as its model, as the scalar refresh does).
     /// Only the lanes in `active` keep the new state.
     #[inline(always)]
-    fn update(
+    fn update<T: Lane>(
         &self,
         pack: &mut Pack,
-        poses: &mut Poses,
+        poses: &mut Poses<T>,
         placed: &[Placed],
         mode: VrmMode,
-        active: M,
+        active: T::M,
     ) {
         let plan = self.plan;
         for slot in 0..plan.joints.len() {
@@ -1035,21 +1193,21 @@ impl Ctx<'_> {
                 continue;
             }
             let parent = match plan.parent[slot] {
-                Some(p) => Some(poses.models[p]),
+                Some(p) => Some(Trs::<T>::of(&poses.models[p])),
                 None => None,
             };
-            let local = poses.locals[slot];
+            let local = Trs::<T>::of(&poses.locals[slot]);
             match plan.link_at[slot] {
                 None => {
                     poses.models[slot] = match parent {
-                        Some(p) => p.mul(&local),
-                        None => local,
+                        Some(p) => p.mul(&local).f(),
+                        None => local.f(),
                     }
                 }
                 Some(i) => {
                     let (rotation, own_t) =
                         self.link(i, pack, poses, placed, parent.as_ref(), mode, active);
-                    poses.models[slot] = match parent {
+                    let model = match parent {
                         // `p * turned`, its translation (`own_t`) already computed.
                         Some(p) => Trs {
                             t: own_t,
@@ -1062,6 +1220,7 @@ impl Ctx<'_> {
                             ..local
                         },
                     };
+                    poses.models[slot] = model.f();
                 }
             }
         }
@@ -1070,41 +1229,48 @@ impl Ctx<'_> {
     /// One link: Verlet step, collisions, the joint turned toward the new tail.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
-    fn link(
+    fn link<T: Lane>(
         &self,
         i: usize,
         pack: &mut Pack,
-        poses: &Poses,
+        poses: &Poses<T>,
         placed: &[Placed],
-        parent: Option<&Trs>,
+        parent: Option<&Trs<T>>,
         mode: VrmMode,
-        active: M,
-    ) -> (Q, V3) {
+        active: T::M,
+    ) -> (Q<T>, V3<T>) {
         let lp = &self.plan.links[i];
         let comp = poses.comp;
         let (parent_world, own_t) = match parent {
-            Some(p) => (comp.mul(p), p.transform_point(poses.locals[lp.slot].t)),
-            None => (comp, poses.models[lp.slot].t),
+            Some(p) => (
+                comp.mul(p),
+                p.transform_point(V3::of(poses.locals[lp.slot].t)),
+            ),
+            None => (comp, V3::of(poses.models[lp.slot].t)),
         };
         let position = comp.transform_point(own_t);
         let center = match lp.center {
-            Some(c) => Some(comp.mul(&poses.models[c])),
+            Some(c) => Some(comp.mul(&Trs::of(&poses.models[c]))),
             None => None,
         };
+        let (current_stored, prev_stored) = (
+            V3::<T>::of(pack.current_tail[i]),
+            V3::<T>::of(pack.prev_tail[i]),
+        );
         let (current, prev) = match &center {
             Some(c) => (
-                c.transform_point(pack.current_tail[i]),
-                c.transform_point(pack.prev_tail[i]),
+                c.transform_point(current_stored),
+                c.transform_point(prev_stored),
             ),
-            None => (pack.current_tail[i], pack.prev_tail[i]),
+            None => (current_stored, prev_stored),
         };
         let rest_dir = parent_world.r.mul_vec3(V3::splat(lp.rest_bone));
-        let inertia = (current - prev) * F::splat(lp.keep);
-        let stiffness = rest_dir * F::splat(self.stiffness_dt[i]);
+        let inertia = (current - prev) * T::splat(lp.keep);
+        let stiffness = rest_dir * T::splat(self.stiffness_dt[i]);
         let external = V3::splat(self.external[i]);
         let length = match (mode, lp.tail_slot) {
-            (VrmMode::ThreeVrm, Some(_)) => (pack.stale_tail[i] - position).length(),
-            _ => pack.length[i],
+            (VrmMode::ThreeVrm, Some(_)) => (V3::of(pack.stale_tail[i]) - position).length(),
+            _ => T::of(pack.length[i]),
         };
         let next = position
             + (current + inertia + stiffness + external - position).normalize_or(rest_dir) * length;
@@ -1123,16 +1289,16 @@ impl Ctx<'_> {
         };
         // Turn the joint toward the tail, from its rest frame under the current parent.
         let rotation = self.turn(lp, &parent_world, next);
-        pack.prev_tail[i] = V3::select(active, pack.current_tail[i], pack.prev_tail[i]);
-        pack.current_tail[i] = V3::select(active, stored, pack.current_tail[i]);
-        pack.rotation[i] = Q::select(active, rotation, pack.rotation[i]);
+        pack.prev_tail[i] = V3::select(active, current_stored, prev_stored).f();
+        pack.current_tail[i] = V3::select(active, stored, current_stored).f();
+        pack.rotation[i] = Q::select(active, rotation, Q::of(pack.rotation[i])).f();
         (rotation, own_t)
     }
 
     /// The local rotation that points the link's bone at `tail` (world): the rest local
     /// rotation turned from the bone axis to the tail seen from the rest frame.
     #[inline(always)]
-    fn turn(&self, lp: &LinkPlan, parent_world: &Trs, tail: V3) -> Q {
+    fn turn<T: Lane>(&self, lp: &LinkPlan, parent_world: &Trs<T>, tail: V3<T>) -> Q<T> {
         let rest_world = parent_world.mul(&Trs::splat(&lp.rest_local));
         let to = rest_world
             .inverse_transform_point(tail)
@@ -1146,21 +1312,22 @@ impl Ctx<'_> {
     /// the tail and the lanes where a collider acted.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
-    fn collide_tail(
+    fn collide_tail<T: Lane>(
         &self,
         lp: &LinkPlan,
         placed: &[Placed],
-        position: V3,
-        length: F,
-        rest_dir: V3,
-        mut tail: V3,
+        position: V3<T>,
+        length: T,
+        rest_dir: V3<T>,
+        mut tail: V3<T>,
         exact: bool,
-    ) -> (V3, M) {
-        let mut acted = M::NONE;
+    ) -> (V3<T>, T::M) {
+        let mut acted = <T::M as Mask>::NONE;
         let colliders = &self.rig.link_colliders[lp.colliders.clone()];
         for &c in colliders {
             let shape = &self.plan.colliders[c].1;
-            if let Some((dir, dist, hit)) = contact(shape, &placed[c], tail, lp.hit_radius) {
+            let pl = Placed::<T>::of(&placed[c]);
+            if let Some((dir, dist, hit)) = contact(shape, &pl, tail, lp.hit_radius) {
                 let pushed =
                     position + (tail - dir * dist - position).normalize_or(rest_dir) * length;
                 tail = V3::select(hit, pushed, tail);
@@ -1168,22 +1335,23 @@ impl Ctx<'_> {
             }
         }
         if exact {
-            let zero = F::splat(0.0);
+            let zero = T::splat(0.0);
             for _ in 0..2 {
-                let mut changed = M::NONE;
+                let mut changed = <T::M as Mask>::NONE;
                 for &c in colliders {
                     let shape = &self.plan.colliders[c].1;
-                    let Some(before) = penetration(shape, &placed[c], tail, lp.hit_radius) else {
+                    let pl = Placed::<T>::of(&placed[c]);
+                    let Some(before) = penetration(shape, &pl, tail, lp.hit_radius) else {
                         continue;
                     };
                     let inside = zero.lt(before);
                     if !inside.any() {
                         continue;
                     }
-                    let t = settle_one(shape, &placed[c], position, length, tail, lp.hit_radius);
-                    let after = match penetration(shape, &placed[c], t, lp.hit_radius) {
+                    let t = settle_one(shape, &pl, position, length, tail, lp.hit_radius);
+                    let after = match penetration(shape, &pl, t, lp.hit_radius) {
                         Some(p) => p,
-                        None => F::splat(f32::NEG_INFINITY),
+                        None => T::splat(f32::NEG_INFINITY),
                     };
                     let better = inside.and(after.lt(before));
                     changed = changed.or(better.and(differs(t, tail)));
@@ -1201,7 +1369,7 @@ impl Ctx<'_> {
     /// Fixed mode: whole steps of `1/step_rate` up to now for the lanes not reset, each
     /// with the animated pose and the character transform interpolated to its time.
     #[inline(always)]
-    fn run_fixed(&self, pack: &mut Pack, s: &mut Scratch, reset: M) {
+    fn run_fixed<T: Lane>(&self, pack: &mut Pack, s: &mut Scratch, reset: M) {
         let opts = &self.rig.options;
         let h = 1.0 / opts.step_rate;
         let dt = self.dt;
@@ -1237,7 +1405,7 @@ impl Ctx<'_> {
         for k in 1..=most {
             let active = M::from_bools(std::array::from_fn(|l| !reset.get(l) && k <= steps[l]));
             let mut w = [1.0f32; LANES];
-            let mut comp = Trs::splat(&Transform::IDENTITY);
+            let mut comp = Trs::<F>::splat(&Transform::IDENTITY);
             for lane in 0..LANES {
                 // Where this step ends between last frame (0) and this frame (1).
                 let end = k as f32 * h - acc_old[lane] + skipped[lane];
@@ -1251,12 +1419,14 @@ impl Ctx<'_> {
                 step_locals[slot] = pack.prev_locals[slot].lerp(&locals[slot], w);
                 // The scalar step refreshes every joint, a root as its local.
                 step_models[slot] = match self.plan.parent[slot] {
-                    Some(p) => step_models[p].mul(&step_locals[slot]),
+                    Some(p) => Trs::<T>::of(&step_models[p])
+                        .mul(&Trs::of(&step_locals[slot]))
+                        .f(),
                     None => step_locals[slot],
                 };
             }
             let mut poses = Poses {
-                comp,
+                comp: Trs::<T>::of(&comp),
                 locals: step_locals,
                 models: step_models,
             };
@@ -1265,6 +1435,7 @@ impl Ctx<'_> {
                 pack.rotation_before[i] =
                     Q::select(active, pack.rotation[i], pack.rotation_before[i]);
             }
+            let active = <T::M as Mask>::of(active);
             self.update(pack, &mut poses, placed, VrmMode::Fixed, active);
         }
     }

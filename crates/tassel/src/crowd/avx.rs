@@ -1,0 +1,256 @@
+//! The crowd's AVX lane type: [`Fa`], one `__m256` per [`F`], every operation one
+//! 256-bit instruction.
+//!
+//! Why it exists: the lane types over [`F`] (arrays of eight `f32`) leave vectorisation to
+//! LLVM, which does it well in small functions but, in a whole inlined VRM step, splits a
+//! good part of it into 128-bit halves and per-lane shuffles (measured: in `step_avx2` a
+//! third of the arithmetic was 128-bit, with ~1 000 shuffles and inserts). Written with
+//! the intrinsics, every lane operation is one instruction whatever the context.
+//!
+//! Each operation is the IEEE operation per lane that [`F`]'s is (add, subtract,
+//! multiply, divide, square root: correctly rounded; negation and `abs`: the sign bit;
+//! comparisons: ordered, `!=` unordered as Rust's; select: bitwise), so both types give
+//! the same bits; `tests` checks it operation by operation.
+//!
+//! **Soundness.** The intrinsics need AVX. [`Fa`] and [`Ma`] are private to the crowd and
+//! only ever created inside functions compiled with `#[target_feature(enable = "avx2")]`
+//! that are called after `is_x86_feature_detected!("avx2")` said yes (`Ctx::run` in
+//! `vrm.rs`, `Ctx::step` and `Ctx::model_pose` in `chain.rs`; the tests below check the
+//! same first), so no AVX instruction runs on a CPU without it. The operations are
+//! `#[inline(always)]` so that they are compiled inside those functions.
+#![allow(unsafe_code)]
+
+use super::lanes::{Lane, Mask, F, M};
+use std::arch::x86_64::*;
+use std::ops::{Add, Div, Mul, Neg, Sub};
+
+/// Eight `f32` lanes in one AVX register.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Fa(__m256);
+
+/// A per-lane condition of [`Fa`] (all bits set when true).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Ma(__m256);
+
+impl PartialEq for Ma {
+    #[inline(always)]
+    fn eq(&self, o: &Ma) -> bool {
+        // SAFETY: see the module's documentation. Every lane of a mask is all ones or all
+        // zeros (comparisons, and `M`'s, make them so), so its sign bits are the mask.
+        unsafe { _mm256_movemask_ps(self.0) == _mm256_movemask_ps(o.0) }
+    }
+}
+
+macro_rules! binary {
+    ($tr:ident, $f:ident, $intr:ident) => {
+        impl $tr for Fa {
+            type Output = Fa;
+            #[inline(always)]
+            fn $f(self, o: Fa) -> Fa {
+                // SAFETY: see the module's documentation (only run where AVX is).
+                Fa(unsafe { $intr(self.0, o.0) })
+            }
+        }
+    };
+}
+binary!(Add, add, _mm256_add_ps);
+binary!(Sub, sub, _mm256_sub_ps);
+binary!(Mul, mul, _mm256_mul_ps);
+binary!(Div, div, _mm256_div_ps);
+
+impl Neg for Fa {
+    type Output = Fa;
+    #[inline(always)]
+    fn neg(self) -> Fa {
+        // SAFETY: see the module's documentation. Flips the sign bit, as `-x` does.
+        Fa(unsafe { _mm256_xor_ps(self.0, _mm256_set1_ps(-0.0)) })
+    }
+}
+
+impl Lane for Fa {
+    type M = Ma;
+    #[inline(always)]
+    fn splat(v: f32) -> Fa {
+        // SAFETY: see the module's documentation.
+        Fa(unsafe { _mm256_set1_ps(v) })
+    }
+    #[inline(always)]
+    fn of(f: F) -> Fa {
+        // SAFETY: `F` is eight `f32` aligned to 32 bytes; an aligned load of them. (A
+        // load needs no AVX state beyond what the module's documentation guarantees.)
+        Fa(unsafe { _mm256_load_ps(f.0.as_ptr()) })
+    }
+    #[inline(always)]
+    fn f(self) -> F {
+        let mut f = F([0.0; 8]);
+        // SAFETY: an aligned store into `F`'s eight `f32`, aligned to 32 bytes.
+        unsafe { _mm256_store_ps(f.0.as_mut_ptr(), self.0) };
+        f
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Fa {
+        // SAFETY: see the module's documentation.
+        Fa(unsafe { _mm256_sqrt_ps(self.0) })
+    }
+    #[inline(always)]
+    fn abs(self) -> Fa {
+        // SAFETY: see the module's documentation. Clears the sign bit, as `f32::abs`.
+        Fa(unsafe { _mm256_andnot_ps(_mm256_set1_ps(-0.0), self.0) })
+    }
+    #[inline(always)]
+    fn lt(self, o: Fa) -> Ma {
+        // SAFETY: see the module's documentation. Ordered: false with NaN, as `<`.
+        Ma(unsafe { _mm256_cmp_ps::<_CMP_LT_OQ>(self.0, o.0) })
+    }
+    #[inline(always)]
+    fn le(self, o: Fa) -> Ma {
+        // SAFETY: see the module's documentation. Ordered: false with NaN, as `<=`.
+        Ma(unsafe { _mm256_cmp_ps::<_CMP_LE_OQ>(self.0, o.0) })
+    }
+    #[inline(always)]
+    fn ne(self, o: Fa) -> Ma {
+        // SAFETY: see the module's documentation. Unordered: true with NaN, as `!=`.
+        Ma(unsafe { _mm256_cmp_ps::<_CMP_NEQ_UQ>(self.0, o.0) })
+    }
+    #[inline(always)]
+    fn finite(self) -> Ma {
+        // |x| < ∞: false for NaN (ordered) and for ±∞, true for every finite value.
+        self.abs().lt(Fa::splat(f32::INFINITY))
+    }
+    #[inline(always)]
+    fn select(m: Ma, a: Fa, b: Fa) -> Fa {
+        // SAFETY: see the module's documentation. `m` is all ones or all zeros per lane,
+        // so the sign-bit blend picks whole lanes, as `F::select`'s bitwise choice.
+        Fa(unsafe { _mm256_blendv_ps(b.0, a.0, m.0) })
+    }
+}
+
+impl Mask for Ma {
+    // All bits clear / all bits set, as `M`'s constants. SAFETY: any 32 bytes are a valid
+    // `__m256`; the transmute only reinterprets the bits.
+    const NONE: Ma = Ma(unsafe { std::mem::transmute::<[u32; 8], __m256>([0; 8]) });
+    const ALL: Ma = Ma(unsafe { std::mem::transmute::<[u32; 8], __m256>([!0; 8]) });
+    #[inline(always)]
+    fn and(self, o: Ma) -> Ma {
+        // SAFETY: see the module's documentation.
+        Ma(unsafe { _mm256_and_ps(self.0, o.0) })
+    }
+    #[inline(always)]
+    fn or(self, o: Ma) -> Ma {
+        // SAFETY: see the module's documentation.
+        Ma(unsafe { _mm256_or_ps(self.0, o.0) })
+    }
+    #[inline(always)]
+    fn not(self) -> Ma {
+        // SAFETY: see the module's documentation.
+        Ma(unsafe { _mm256_xor_ps(self.0, Ma::ALL.0) })
+    }
+    #[inline(always)]
+    fn any(self) -> bool {
+        // SAFETY: see the module's documentation. Lanes are all ones or all zeros, so a
+        // lane is set exactly when its sign bit is.
+        unsafe { _mm256_movemask_ps(self.0) != 0 }
+    }
+    #[inline(always)]
+    fn of(m: M) -> Ma {
+        // SAFETY: `M` is eight `u32` aligned to 32 bytes: an aligned load of their bits.
+        Ma(unsafe { _mm256_load_ps(m.0.as_ptr().cast::<f32>()) })
+    }
+    #[inline(always)]
+    fn m(self) -> M {
+        let mut m = M([0; 8]);
+        // SAFETY: an aligned store of the eight lanes' bits into `M` (32-byte aligned).
+        unsafe { _mm256_store_ps(m.0.as_mut_ptr().cast::<f32>(), self.0) };
+        m
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rng::SplitMix64 as Rng;
+
+    /// Runs `f` only where the CPU has AVX2 (the type's precondition), saying so else.
+    fn with_avx2(f: impl FnOnce()) {
+        if std::arch::is_x86_feature_detected!("avx2") {
+            f()
+        } else {
+            eprintln!("skipped: this CPU has no AVX2, the AVX lane type cannot run here");
+        }
+    }
+
+    fn same(a: F, b: F) -> bool {
+        a.0.iter()
+            .zip(b.0.iter())
+            .all(|(x, y)| x.to_bits() == y.to_bits())
+    }
+
+    /// Values with every special case: ±0, ±∞, NaN, subnormals, huge, tiny, ordinary.
+    fn values(rng: &mut Rng) -> F {
+        let special = [
+            0.0,
+            -0.0,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::NAN,
+            1e-40,
+            -1e-40,
+            3.4e38,
+            -3.4e38,
+            1e-30,
+            1.0,
+            -1.0,
+        ];
+        F(std::array::from_fn(|_| {
+            let r = rng.next_u64();
+            if r % 4 == 0 {
+                special[(r >> 8) as usize % special.len()]
+            } else {
+                let x = (rng.next_u64() % 2_000_000) as f32 / 1000.0 - 1000.0;
+                if r % 4 == 1 {
+                    x * 1e-3
+                } else {
+                    x
+                }
+            }
+        }))
+    }
+
+    #[test]
+    fn avx_lane_operations_give_the_bits_of_f() {
+        with_avx2(|| {
+            let mut rng = Rng::new(0xA5A5);
+            for _ in 0..20_000 {
+                let (a, b) = (values(&mut rng), values(&mut rng));
+                let (x, y) = (Fa::of(a), Fa::of(b));
+                assert!(same((x + y).f(), a + b), "{a:?} + {b:?}");
+                assert!(same((x - y).f(), a - b), "{a:?} - {b:?}");
+                assert!(same((x * y).f(), a * b), "{a:?} * {b:?}");
+                assert!(same((x / y).f(), a / b), "{a:?} / {b:?}");
+                assert!(same((-x).f(), -a), "-{a:?}");
+                assert!(same(x.sqrt().f(), a.sqrt()), "sqrt {a:?}");
+                assert!(same(Lane::abs(x).f(), a.abs()), "abs {a:?}");
+                assert!(same(Lane::clamp01(x).f(), a.clamp01()), "clamp01 {a:?}");
+                assert!(same(Lane::max(x, y).f(), a.max(b)), "max {a:?} {b:?}");
+                assert!(same(Lane::signum(x).f(), F(a.0.map(f32::signum))));
+                assert_eq!(Lane::lt(x, y).m(), a.lt(b), "{a:?} < {b:?}");
+                assert_eq!(Lane::le(x, y).m(), a.le(b), "{a:?} <= {b:?}");
+                assert_eq!(Lane::gt(x, y).m(), a.gt(b), "{a:?} > {b:?}");
+                assert_eq!(Lane::ne(x, y).m(), a.ne(b), "{a:?} != {b:?}");
+                assert_eq!(Lane::finite(x).m(), a.finite(), "finite {a:?}");
+                let m = a.lt(b);
+                let (mx, ma) = (Ma::of(m), m);
+                assert!(same(Fa::select(mx, x, y).f(), F::select(ma, a, b)));
+                let n = b.finite();
+                let nx = Ma::of(n);
+                assert_eq!(mx.and(nx).m(), ma.and(n));
+                assert_eq!(mx.or(nx).m(), ma.or(n));
+                assert_eq!(Mask::not(mx).m(), ma.not());
+                assert_eq!(Mask::any(mx), ma.any());
+                assert_eq!(mx == Ma::ALL, ma == M::ALL);
+                assert_eq!(mx == Ma::NONE, ma == M::NONE);
+                assert_eq!(x.get(3).to_bits(), a.0[3].to_bits());
+            }
+        });
+    }
+}
