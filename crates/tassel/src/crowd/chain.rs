@@ -866,7 +866,7 @@ impl Ctx<'_> {
             }
             TimeMode::Classic => F::splat(1.0),
         };
-        output_lanes(
+        output_lanes::<T>(
             rig,
             ci,
             w,

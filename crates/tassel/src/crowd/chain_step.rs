@@ -425,7 +425,7 @@ pub(super) fn step_lanes<T: Lane>(
 /// the arithmetic, not the narrow phase).
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-pub(super) fn output_lanes(
+pub(super) fn output_lanes<T: Lane>(
     rig: &ChainRig,
     ci: usize,
     w: F,
@@ -440,20 +440,22 @@ pub(super) fn output_lanes(
     near: &mut [M],
 ) {
     let chain = &rig.chains[ci];
-    let alpha = F::splat(chain.settings.alpha);
+    let alpha = T::splat(chain.settings.alpha);
     let list = &chain.colliders;
     let y_axis = V3::splat(Vec3::Y);
+    let w = T::of(w);
+    let live_t = <T::M as Mask>::of(live);
     for p in chain.points.clone() {
-        let t = targets[p];
-        let d = dev_before[p].lerp(dev[p], w) * alpha;
+        let t = V3::<T>::of(targets[p]);
+        let d = V3::<T>::of(dev_before[p]).lerp(V3::of(dev[p]), w) * alpha;
         let parent = rig.parent[p];
         if parent == NONE {
-            out[p] = t;
+            out[p] = t.f();
             continue;
         }
         let pp = parent as usize;
-        let anim = t - targets[pp];
-        let from = out[pp];
+        let anim = t - V3::of(targets[pp]);
+        let from = V3::<T>::of(out[pp]);
         let length = anim.length();
         let fallback = anim.normalize_or(y_axis);
         let mut x = restore_length(t + d, from, fallback, length);
@@ -467,7 +469,7 @@ pub(super) fn output_lanes(
             near,
         );
         let near = &*near;
-        let mut open = live;
+        let mut open = live_t;
         for pass in 0..3 {
             let (y, moved) = collide(list, colliders, bounds, shapes, near, x, None, r, open);
             open = open.and(moved);
@@ -484,7 +486,7 @@ pub(super) fn output_lanes(
                 break;
             }
         }
-        out[p] = x;
+        out[p] = x.f();
     }
 }
 

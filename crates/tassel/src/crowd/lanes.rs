@@ -1055,11 +1055,11 @@ impl Q {
     }
 }
 
-impl V3 {
+impl<T: Lane> V3<T> {
     /// glam's `Vec3::lerp`: `self·(1 − s) + rhs·s`.
     #[inline(always)]
-    pub fn lerp(self, rhs: V3, s: F) -> V3 {
-        self * (F::splat(1.0) - s) + rhs * s
+    pub fn lerp(self, rhs: V3<T>, s: T) -> V3<T> {
+        self * (T::splat(1.0) - s) + rhs * s
     }
 }
 
