@@ -4,11 +4,13 @@
 //! operation ([`super::lanes`] repeats glam's IEEE operations lane by lane), with every
 //! branch that depends on a character's state taken per lane (a mask). The broad phase,
 //! the colliders' quick rejection and, for keep-out spheres and capsules, the narrow
-//! phase's own contact decision run in lanes; the narrow phase itself is left to the
-//! scalar colliders, asked only for the lanes those leave.
+//! phase's contact decision and its push of a point found inside run in lanes; a step
+//! that entered one of those (the swept contact) and every other shape are left to the
+//! scalar colliders, asked only for the lanes that need them.
 
 use super::lanes::{
-    closest_params_segment_segment, closest_point_on_segment, Lane, Mask, F, LANES, M, Q, V3,
+    closest_params_segment_segment, closest_point_on_segment, differs, Lane, Mask, F, LANES, M, Q,
+    V3,
 };
 use crate::collide::{entry_radius, PlacedCollider, Shape};
 use crate::dynamics::chain::compile::{ChainRig, NONE};
@@ -64,9 +66,9 @@ pub(super) struct LaneShape {
 /// Where a collider's contact decision is made.
 #[derive(Debug, Clone, Copy)]
 pub(super) enum Decision {
-    /// A keep-out sphere of this radius: in lanes ([`sphere_may_move`]).
+    /// A keep-out sphere of this radius: in lanes ([`sphere_contact`]).
     Sphere(f32),
-    /// A capsule of this radius: in lanes ([`capsule_may_move`]).
+    /// A capsule of this radius: in lanes ([`capsule_contact`]).
     Capsule(f32),
     /// Any other shape: the scalar narrow phase, for every lane asked.
     Scalar,
@@ -91,36 +93,69 @@ impl LaneShape {
     }
 }
 
-/// The lanes whose point `p` (the step from `prev`) a keep-out sphere may move, decided
-/// as [`crate::collide::push_out_of_sphere`] decides it, with its operations: the step
-/// entered the entry surface from outside it, or `p` lies inside `limit`. Every other
-/// lane gets `p` back from it unchanged.
+/// A keep-out sphere's or capsule's answer for a point per lane, computed with the
+/// narrow phase's own operations: which lanes it may move (the others get their point
+/// back unchanged), which of those the step *entered* (the swept contact, left to the
+/// scalar narrow phase: rarer, and with a root finding of its own), and for the lanes it
+/// may move without an entry, the point it gives back (pushed out to the surface).
+#[derive(Clone, Copy)]
+struct LaneContact<T: Lane> {
+    may: T::M,
+    entered: T::M,
+    pushed: V3<T>,
+}
+
+/// [`crate::collide::push_out_of_sphere`] per lane, as far as it goes without an entry:
+/// the step entered the entry surface from outside it (`entered`), or `p` lies inside
+/// `limit` and is pushed out along the shortest way (`pushed`, with the function's
+/// fallback direction).
 #[inline(always)]
-fn sphere_may_move<T: Lane>(p: V3<T>, prev: V3<T>, center: V3<T>, limit: f32) -> T::M {
+fn sphere_contact<T: Lane>(p: V3<T>, prev: V3<T>, center: V3<T>, limit: f32) -> LaneContact<T> {
     let inner2 = T::splat(entry_radius(limit).powi(2));
     let from = prev - center;
     let prev_out = inner2.le(from.dot(from));
     let c = closest_point_on_segment(center, prev, p) - center;
     let entered = prev_out.and(c.dot(c).lt(inner2));
     let d = p - center;
-    entered.or(d.dot(d).lt(T::splat(limit * limit)))
+    // `outside_sphere(p, center, limit, normalize_or(prev - center, Y))` where it pushes.
+    let fallback = from.normalize_or(V3::splat(Vec3::Y));
+    LaneContact {
+        may: entered.or(d.dot(d).lt(T::splat(limit * limit))),
+        entered,
+        pushed: center + d.normalize_or(fallback) * T::splat(limit),
+    }
 }
 
-/// The lanes whose point a capsule `a`–`b` may move, as
-/// [`crate::collide::push_out_of_capsule`] decides it: the step started at or beyond the
-/// entry surface and its closest approach to the axis is inside it, or `p` lies inside
-/// `limit`.
+/// [`crate::collide::push_out_of_capsule`] (capsule `a`–`b`) per lane, as far as it goes
+/// without an entry: the step started at or beyond the entry surface and its closest
+/// approach to the axis is inside it (`entered`), or `p` lies inside `limit` and is pushed
+/// out to the nearest point of the surface (`pushed`, with the function's fallback
+/// direction, from the step's start).
 #[inline(always)]
-fn capsule_may_move<T: Lane>(p: V3<T>, prev: V3<T>, a: V3<T>, b: V3<T>, limit: f32) -> T::M {
+fn capsule_contact<T: Lane>(
+    p: V3<T>,
+    prev: V3<T>,
+    a: V3<T>,
+    b: V3<T>,
+    limit: f32,
+) -> LaneContact<T> {
     let inner = T::splat(entry_radius(limit));
-    let prev_dist = (prev - closest_point_on_segment(prev, a, b)).length();
+    let from_axis = prev - closest_point_on_segment(prev, a, b);
+    let prev_dist = from_axis.length();
     let (s, t) = closest_params_segment_segment(prev, p, a, b);
     let on_path = prev + (p - prev) * s;
     let on_axis = a + (b - a) * t;
     let gap = on_path - on_axis;
     let entered = inner.le(prev_dist).and(gap.dot(gap).lt(inner * inner));
-    let d = p - closest_point_on_segment(p, a, b);
-    entered.or(d.dot(d).lt(T::splat(limit * limit)))
+    let c = closest_point_on_segment(p, a, b);
+    let d = p - c;
+    // `outside_capsule(p, a, b, limit, prev_fallback())` where it pushes.
+    let fallback = from_axis.normalize_or((b - a).any_orthonormal());
+    LaneContact {
+        may: entered.or(d.dot(d).lt(T::splat(limit * limit))),
+        entered,
+        pushed: c + d.normalize_or(fallback) * T::splat(limit),
+    }
 }
 
 /// Everything one lane step reads besides the rig and the points (as
@@ -264,13 +299,28 @@ fn collide<T: Lane>(
                 continue;
             }
         }
-        match shape.decision {
-            Decision::Sphere(radius) => ask = ask.and(sphere_may_move(y, q, bc, radius + r)),
+        // Keep-out spheres and capsules: the lanes asked that the step did not enter get
+        // their point from the lanes' own narrow phase; the rest (entries, other shapes)
+        // from the scalar one.
+        let contact = match shape.decision {
+            Decision::Sphere(radius) => Some(sphere_contact(y, q, bc, radius + r)),
             Decision::Capsule(radius) => {
                 let (a, b) = (V3::of(bound.a), V3::of(bound.b));
-                ask = ask.and(capsule_may_move(y, q, a, b, radius + r))
+                Some(capsule_contact(y, q, a, b, radius + r))
             }
-            Decision::Scalar => {}
+            Decision::Scalar => None,
+        };
+        if let Some(contact) = contact {
+            ask = ask.and(contact.may);
+            let pushed = ask.and(contact.entered.not());
+            if pushed.any() {
+                y = V3::select(pushed, contact.pushed, y);
+                moved = pushed.and(differs(y, x)).or(pushed.not().and(moved));
+            }
+            ask = ask.and(contact.entered);
+            if !ask.any() {
+                continue;
+            }
         }
         // The scalar narrow phase, lane by lane (in `F`, whose lanes are plain memory).
         let (ask, mut yf, qf, xf) = (ask.m(), y.f(), q.f(), x.f());
@@ -497,15 +547,18 @@ mod tests {
     use crate::math::Transform;
     use glam::Quat;
 
-    /// The lanes' contact decision for keep-out spheres and capsules is sound: a lane
-    /// it turns away gets its point back from the scalar narrow phase bit for bit. Steps
-    /// start and end inside, on and outside the shapes, graze them and pass through them;
-    /// both answers must occur often (a decision that always asks, or never, fails).
+    /// The lanes' contact for keep-out spheres and capsules gives the scalar narrow
+    /// phase's bits: a lane it turns away gets its point back from the scalar narrow
+    /// phase unchanged, and a lane it pushes without an entry gets the point the scalar
+    /// narrow phase gives. Steps start and end inside, on and outside the shapes, graze
+    /// them and pass through them; every answer must occur often (a decision that always
+    /// asks, or never, fails). In `F` and, where the CPU has it, in the AVX lane type.
     #[test]
-    fn lane_contact_decision_turns_away_only_points_the_narrow_phase_keeps() {
+    fn lane_contact_gives_the_narrow_phase_bits() {
         let mut rng = SplitMix64::new(5);
         let mut u = |lo: f32, hi: f32| rng.range_f32(lo, hi);
-        let (mut kept, mut asked, mut moved) = (0, 0, 0);
+        let (mut kept, mut asked, mut moved, mut entries) = (0, 0, 0, 0);
+        let bits = |v: V3| [v.x, v.y, v.z].map(|c| c.0.map(f32::to_bits));
         for round in 0..3000 {
             let capsule = round % 2 == 1;
             let radius = u(0.01, 0.1);
@@ -535,10 +588,12 @@ mod tests {
                 let reach = limit + 0.5 * length;
                 let dir = Vec3::new(u(-1.0, 1.0), u(-1.0, 1.0), u(-1.0, 1.0)).normalize_or(Vec3::X);
                 let from = centre + dir * u(0.0, 2.0 * reach);
-                let to = match (round + l) % 4 {
+                let to = match (round + l) % 5 {
                     0 => from,
                     1 => centre - dir * u(0.0, 2.0 * reach),
                     2 => from + Vec3::new(u(-0.05, 0.05), u(-0.05, 0.05), u(-0.05, 0.05)),
+                    // On the centre (the axis): the push takes the fallback direction.
+                    3 => centre,
                     _ => centre + (from - centre).normalize_or(Vec3::Y) * limit,
                 };
                 p.set(l, to);
@@ -547,34 +602,65 @@ mod tests {
                 b.set(l, bound.b.get(0));
                 c.set(l, centre);
             }
-            let may = if capsule {
-                capsule_may_move(p, q, a, b, limit)
+            let contact = if capsule {
+                capsule_contact(p, q, a, b, limit)
             } else {
-                sphere_may_move(p, q, c, limit)
+                sphere_contact(p, q, c, limit)
             };
+            let (may, entered, pushed) = (contact.may, contact.entered, contact.pushed);
+            #[cfg(target_arch = "x86_64")]
+            if std::is_x86_feature_detected!("avx2") {
+                // SAFETY: the CPU has AVX2 (checked just above).
+                #[allow(unsafe_code)]
+                let avx = unsafe { contact_avx2(capsule, p, q, a, b, c, limit) };
+                assert_eq!(avx.0, may, "round {round}: AVX decision");
+                assert_eq!(avx.1, entered, "round {round}: AVX entry");
+                assert_eq!(bits(avx.2), bits(pushed), "round {round}: AVX push");
+            }
             for l in 0..LANES {
                 let want = if capsule {
                     push_out_of_capsule(p.get(l), q.get(l), a.get(l), b.get(l), limit)
                 } else {
                     push_out_of_sphere(p.get(l), q.get(l), c.get(l), limit)
                 };
-                let same =
-                    want.to_array().map(f32::to_bits) == p.get(l).to_array().map(f32::to_bits);
+                let bits_of = |v: Vec3| v.to_array().map(f32::to_bits);
+                let same = bits_of(want) == bits_of(p.get(l));
                 if may.0[l] == 0 {
                     assert!(
                         same,
                         "round {round} lane {l}: turned away, but the narrow phase moves it"
                     );
                     kept += 1;
+                } else if entered.0[l] != 0 {
+                    entries += 1;
                 } else {
+                    assert_eq!(
+                        bits_of(pushed.get(l)),
+                        bits_of(want),
+                        "round {round} lane {l}: pushed in lanes"
+                    );
                     asked += 1;
                     moved += usize::from(!same);
                 }
             }
         }
         assert!(
-            kept > 2000 && asked > 2000 && moved > 1000,
-            "{kept} {asked} {moved}"
+            kept > 2000 && asked > 2000 && moved > 1000 && entries > 1000,
+            "{kept} {asked} {moved} {entries}"
         );
+    }
+
+    /// [`capsule_contact`] or [`sphere_contact`] in the AVX lane type, back in `F`/`M`.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn contact_avx2(capsule: bool, p: V3, q: V3, a: V3, b: V3, c: V3, limit: f32) -> (M, M, V3) {
+        use crate::crowd::avx::Fa;
+        let (p, q) = (V3::<Fa>::of(p), V3::<Fa>::of(q));
+        let k = if capsule {
+            capsule_contact(p, q, V3::of(a), V3::of(b), limit)
+        } else {
+            sphere_contact(p, q, V3::of(c), limit)
+        };
+        (k.may.m(), k.entered.m(), k.pushed.f())
     }
 }
