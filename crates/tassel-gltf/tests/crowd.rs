@@ -4,44 +4,13 @@
 
 mod common;
 
-use common::{testdata, vrm_files};
-use glam::{Quat, Vec3};
+use common::{bits, input, testdata, vrm_files};
 use std::sync::Arc;
-use tassel::crowd::{CrowdPose, VrmCrowd};
+use tassel::crowd::{CrowdPose, SimdUse, VrmCrowd};
 use tassel::dynamics::vrm::{VrmMode, VrmOptions, VrmRig, VrmSpringBones};
 use tassel::dynamics::RigSettings;
 use tassel::{CharacterSim, Skeleton, Transform};
 use tassel_gltf::Model;
-
-/// Character `i` at frame `f`: its own phase of a sway that rolls it over (so that gravity
-/// throws the springs against the colliders), joint 0 and the first spring joint's parent
-/// swinging in the animated pose.
-fn input(sk: &Skeleton, swing: usize, i: usize, f: usize, locals: &mut [Transform]) -> Transform {
-    let t = f as f32 / 60.0 + 0.29 * i as f32;
-    let w = std::f32::consts::TAU * t;
-    locals.copy_from_slice(sk.rest());
-    locals[swing].rotation =
-        sk.rest()[swing].rotation * Quat::from_rotation_x(0.4 * (2.0 * w).sin());
-    let roll = std::f32::consts::FRAC_PI_2 * (1.0 - (0.5 * w).cos());
-    Transform::from_translation_rotation(
-        Vec3::new(
-            0.15 * w.sin(),
-            0.05 * (1.7 * w).sin(),
-            0.1 * (0.6 * w).cos(),
-        ),
-        Quat::from_rotation_y(0.6 * (0.8 * w).sin()) * Quat::from_rotation_z(roll),
-    )
-}
-
-fn bits(t: &Transform) -> Vec<u32> {
-    t.translation
-        .to_array()
-        .into_iter()
-        .chain(t.rotation.to_array())
-        .chain(t.scale.to_array())
-        .map(f32::to_bits)
-        .collect()
-}
 
 /// Five characters, 600 frames (a hitch at frame 300): every local and model transform of
 /// every character the same bits in the crowd and in its own `CharacterSim`. Returns the
@@ -65,7 +34,12 @@ fn compare(
     let mut sims: Vec<CharacterSim> = (0..n)
         .map(|_| {
             crowd.add();
-            CharacterSim::with_vrm(sk.clone(), &RigSettings::default(), bones, options).unwrap()
+            let mut sim =
+                CharacterSim::with_vrm(sk.clone(), &RigSettings::default(), bones, options)
+                    .unwrap();
+            // The readable reference (the lane path is tested against it in vrm_lanes.rs).
+            sim.set_simd(SimdUse::Scalar);
+            sim
         })
         .collect();
     let mut inputs = vec![(Transform::IDENTITY, sk.rest().to_vec()); n];

@@ -3,7 +3,7 @@
 
 use glam::{Quat, Vec3};
 use std::sync::Arc;
-use tassel::crowd::{CrowdPose, VrmCrowd};
+use tassel::crowd::{CrowdPose, SimdUse, VrmCrowd};
 use tassel::dynamics::vrm::{VrmMode, VrmOptions, VrmRig, VrmSpringBones};
 use tassel::dynamics::RigSettings;
 use tassel::{builtin, CharacterSim, Skeleton, Transform};
@@ -70,7 +70,12 @@ fn assert_crowd_matches(
     let mut sims: Vec<CharacterSim> = (0..n)
         .map(|_| {
             crowd.add();
-            CharacterSim::with_vrm(sk.clone(), &RigSettings::default(), bones, options).unwrap()
+            let mut sim =
+                CharacterSim::with_vrm(sk.clone(), &RigSettings::default(), bones, options)
+                    .unwrap();
+            // The readable reference (the lane path is tested against it in vrm_lanes.rs).
+            sim.set_simd(SimdUse::Scalar);
+            sim
         })
         .collect();
     let mut inputs = vec![(Transform::IDENTITY, sk.rest().to_vec()); n];

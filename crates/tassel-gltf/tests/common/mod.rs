@@ -1,7 +1,9 @@
 //! Helpers shared by the glTF tests: test data and the Khronos validator.
 #![allow(dead_code)]
 
+use glam::{Quat, Vec3};
 use std::path::{Path, PathBuf};
+use tassel::{Skeleton, Transform};
 
 /// `../shared/testdata/<rel>` from the repository root, or `None` (with a message) when the
 /// folder is missing and `TASSEL_REQUIRE_TESTDATA` is not set.
@@ -68,4 +70,41 @@ pub fn validate(file: &Path) -> Option<(u64, String)> {
             )
         });
     Some((errors, text))
+}
+
+/// Character `i` at frame `f`: its own phase of a sway that rolls it over (so that gravity
+/// throws the springs against the colliders), joint 0 and the first spring joint's parent
+/// swinging in the animated pose.
+pub fn input(
+    sk: &Skeleton,
+    swing: usize,
+    i: usize,
+    f: usize,
+    locals: &mut [Transform],
+) -> Transform {
+    let t = f as f32 / 60.0 + 0.29 * i as f32;
+    let w = std::f32::consts::TAU * t;
+    locals.copy_from_slice(sk.rest());
+    locals[swing].rotation =
+        sk.rest()[swing].rotation * Quat::from_rotation_x(0.4 * (2.0 * w).sin());
+    let roll = std::f32::consts::FRAC_PI_2 * (1.0 - (0.5 * w).cos());
+    Transform::from_translation_rotation(
+        Vec3::new(
+            0.15 * w.sin(),
+            0.05 * (1.7 * w).sin(),
+            0.1 * (0.6 * w).cos(),
+        ),
+        Quat::from_rotation_y(0.6 * (0.8 * w).sin()) * Quat::from_rotation_z(roll),
+    )
+}
+
+/// A transform's 10 floats as bits (for exact comparisons).
+pub fn bits(t: &Transform) -> Vec<u32> {
+    t.translation
+        .to_array()
+        .into_iter()
+        .chain(t.rotation.to_array())
+        .chain(t.scale.to_array())
+        .map(f32::to_bits)
+        .collect()
 }

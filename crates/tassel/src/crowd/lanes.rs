@@ -881,7 +881,13 @@ pub fn rotation_arc<T: Lane>(from: V3<T>, to: V3<T>) -> Q<T> {
 /// scalar code.
 #[inline(always)]
 pub fn rotation_arc_from<T: Lane>(a: Vec3, half_turn: Quat, to: V3<T>) -> Q<T> {
-    let av = V3::splat(a);
+    rotation_arc_from_lanes(V3::splat(a), Q::splat(half_turn), to)
+}
+
+/// [`rotation_arc_from`] with `a` and `half_turn` per lane (each precomputed with the
+/// scalar code for its lane).
+#[inline(always)]
+pub fn rotation_arc_from_lanes<T: Lane>(av: V3<T>, half_turn: Q<T>, to: V3<T>) -> Q<T> {
     let b = to.normalize_or(av);
     let w = T::splat(1.0) + av.dot(b);
     let c = av.cross(b);
@@ -892,7 +898,7 @@ pub fn rotation_arc_from<T: Lane>(a: Vec3, half_turn: Quat, to: V3<T>) -> Q<T> {
         w,
     }
     .normalize();
-    Q::select(w.lt(T::splat(1e-7)), Q::splat(half_turn), q)
+    Q::select(w.lt(T::splat(1e-7)), half_turn, q)
 }
 
 impl F {

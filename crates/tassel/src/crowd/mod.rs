@@ -15,7 +15,22 @@ mod avx;
 mod chain;
 mod chain_step;
 pub mod lanes;
+pub(crate) mod spring_lanes;
 mod vrm;
+pub(crate) mod vrm_contact;
 
 pub use chain::ChainCrowd;
+
+/// Which code runs a solver step that has a lane path. Every choice gives the same bits
+/// (each lane repeats the scalar operations); they differ in speed only.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum SimdUse {
+    /// The scalar code: the readable reference the lane paths are tested against.
+    Scalar,
+    /// Lanes in portable code (SSE2 on x86_64), never AVX2.
+    Portable,
+    /// Lanes, with AVX2 where the CPU has it (checked at run time).
+    #[default]
+    Auto,
+}
 pub use vrm::{CrowdPose, VrmCrowd};

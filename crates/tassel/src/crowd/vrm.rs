@@ -9,9 +9,8 @@
 
 #[cfg(target_arch = "x86_64")]
 use super::avx::Fa;
-use super::lanes::{
-    closest_point_on_segment, differs, rotation_arc_from, Lane, Mask, Trs, F, LANES, M, Q, V3,
-};
+use super::lanes::{rotation_arc_from, Lane, Mask, Trs, F, LANES, M, Q, V3};
+use super::vrm_contact::{collide_tail, Placed};
 use crate::dynamics::path::CharacterPath;
 use crate::dynamics::vrm::{VrmMode, VrmRig, VrmShape};
 use crate::error::{Error, Result};
@@ -227,39 +226,6 @@ impl Pack {
             needs_reset: [true; LANES],
             resets: [0; LANES],
             error: None,
-        }
-    }
-}
-
-/// A collider placed in world space, per lane: `a` (centre, capsule head, plane point) and
-/// `b` (capsule tail, plane normal), with a bounding sphere for the quick rejection: every
-/// point of a sphere or capsule's axis lies within `half` of `mid`.
-#[derive(Debug, Clone, Copy)]
-struct Placed<T = F> {
-    a: V3<T>,
-    b: V3<T>,
-    mid: V3<T>,
-    half: T,
-}
-
-impl<T: Lane> Placed<T> {
-    #[inline(always)]
-    fn of(p: &Placed) -> Placed<T> {
-        Placed {
-            a: V3::of(p.a),
-            b: V3::of(p.b),
-            mid: V3::of(p.mid),
-            half: T::of(p.half),
-        }
-    }
-
-    #[inline(always)]
-    fn f(&self) -> Placed {
-        Placed {
-            a: self.a.f(),
-            b: self.b.f(),
-            mid: self.mid.f(),
-            half: self.half.f(),
         }
     }
 }
@@ -912,141 +878,6 @@ fn under<T: Lane>(models: &[Trs], parent: Option<usize>, local: &Trs) -> Trs<T> 
     }
 }
 
-/// The specification's signed distance per lane
-/// ([`crate::dynamics::vrm::PlacedVrmCollider::collision`]) with the vector it is measured
-/// along, or `None` when no lane can be in contact.
-///
-/// The early `None` compares against a bounding sphere rounded outward, so it only ever
-/// skips what the exact test would find out of contact: the results keep the scalar bits.
-#[inline(always)]
-fn distance<T: Lane>(shape: &VrmShape, placed: &Placed<T>, p: V3<T>, r: f32) -> Option<(T, V3<T>)> {
-    let zero = T::splat(0.0);
-    let (radius, inside) = match *shape {
-        VrmShape::Sphere { radius, inside, .. } | VrmShape::Capsule { radius, inside, .. } => {
-            (radius, inside)
-        }
-        VrmShape::Plane { .. } => {
-            return Some(((p - placed.a).dot(placed.b) - T::splat(r), placed.b));
-        }
-    };
-    if !inside {
-        // Certainly out of reach: farther from the bounding sphere's centre than its
-        // radius plus the contact distance, with 1e-4 to spare for the rounding of these
-        // few operations (so that no lane the exact test would push is skipped).
-        let reach = (placed.half + T::splat(radius + r)) * T::splat(1.0001) + T::splat(1e-6);
-        let far = (p - placed.mid).dot(p - placed.mid).gt(reach * reach);
-        if far == <T::M as Mask>::ALL {
-            return None;
-        }
-    }
-    let delta = match *shape {
-        VrmShape::Capsule { .. } => {
-            let (a, b) = (placed.a, placed.b);
-            let axis = b - a;
-            let delta = p - a;
-            let dot = axis.dot(delta);
-            let len2 = axis.dot(axis);
-            let beyond = delta - axis;
-            let along = delta - axis * (dot / len2);
-            V3::select(dot.le(zero), delta, V3::select(len2.le(dot), beyond, along))
-        }
-        _ => p - placed.a,
-    };
-    let len = delta.length();
-    Some(if inside {
-        (T::splat(radius - r) - len, delta)
-    } else {
-        (len - T::splat(radius + r), delta)
-    })
-}
-
-/// The push of the specification's collision: `None` when no lane is in contact, else the
-/// direction, the signed distance and the lanes in contact. The direction (three
-/// divisions and a square root) is computed only when a lane is in contact.
-#[inline(always)]
-fn contact<T: Lane>(
-    shape: &VrmShape,
-    placed: &Placed<T>,
-    p: V3<T>,
-    r: f32,
-) -> Option<(V3<T>, T, T::M)> {
-    let (dist, delta) = distance(shape, placed, p, r)?;
-    let hit = dist.lt(T::splat(0.0));
-    if !hit.any() {
-        return None;
-    }
-    let dir = match *shape {
-        VrmShape::Plane { .. } => delta,
-        VrmShape::Sphere { inside, .. } | VrmShape::Capsule { inside, .. } => {
-            let dir = delta.normalize_or(V3::splat(Vec3::ZERO));
-            if inside {
-                -dir
-            } else {
-                dir
-            }
-        }
-    };
-    Some((dir, dist, hit))
-}
-
-/// How far a tail at `p` violates the collider, per lane (≤ 0: not at all), or `None` when
-/// no lane can.
-#[inline(always)]
-fn penetration<T: Lane>(shape: &VrmShape, placed: &Placed<T>, p: V3<T>, r: f32) -> Option<T> {
-    distance(shape, placed, p, r).map(|(d, _)| -d)
-}
-
-/// [`crate::dynamics::vrm::PlacedVrmCollider::settle`] per lane.
-#[inline(always)]
-fn settle_one<T: Lane>(
-    shape: &VrmShape,
-    placed: &Placed<T>,
-    pos: V3<T>,
-    length: T,
-    tail: V3<T>,
-    r: f32,
-) -> V3<T> {
-    let zero = T::splat(0.0);
-    let one = T::splat(1.0);
-    let (a, c, valid) = match *shape {
-        VrmShape::Plane { .. } => {
-            let normal = placed.b;
-            let c = (T::splat(r) - (pos - placed.a).dot(normal)) / length;
-            (normal, c, <T::M as Mask>::ALL)
-        }
-        VrmShape::Sphere { radius, inside, .. } | VrmShape::Capsule { radius, inside, .. } => {
-            let q = match *shape {
-                VrmShape::Capsule { .. } => closest_point_on_segment(tail, placed.a, placed.b),
-                _ => placed.a,
-            };
-            let limit = if inside {
-                (radius - r).max(0.0)
-            } else {
-                radius + r
-            };
-            let d = pos - q;
-            let dl = d.length();
-            let k = (T::splat(limit * limit) - dl * dl - length * length)
-                / (T::splat(2.0) * length * dl);
-            let valid = dl.lt(T::splat(1e-9)).not();
-            if inside {
-                (-d / dl, -k, valid)
-            } else {
-                (d / dl, k, valid)
-            }
-        }
-    };
-    let u = (tail - pos).normalize_or(a);
-    let ua = u.dot(a);
-    let keep = (c - T::splat(1e-6)).le(ua).or(c.lt(T::splat(-1.0)));
-    let straight = pos + a * length;
-    let side = (u - a * ua).normalize_or(a.any_orthonormal());
-    let turned = pos + (a * c + side * (one - c * c).sqrt()) * length;
-    let moved = V3::select(T::splat(1.0).le(c), straight, turned);
-    let unchanged = length.le(zero).or(valid.not()).or(keep);
-    V3::select(unchanged, tail, moved)
-}
-
 /// The joints a frame (or a step) works on: the character transform, locals, models.
 struct Poses<'p, T = F> {
     comp: Trs<T>,
@@ -1308,9 +1139,7 @@ impl Ctx<'_> {
         Q::splat(lp.rest_local.rotation).mul_quat(arc).normalize()
     }
 
-    /// The specification's collision (one push per collider and the projection back to
-    /// the bone length), then with `exact` the settling of what is left inside. Returns
-    /// the tail and the lanes where a collider acted.
+    /// [`collide_tail`] for link `lp` (every lane the same link).
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     fn collide_tail<T: Lane>(
@@ -1320,51 +1149,20 @@ impl Ctx<'_> {
         position: V3<T>,
         length: T,
         rest_dir: V3<T>,
-        mut tail: V3<T>,
+        tail: V3<T>,
         exact: bool,
     ) -> (V3<T>, T::M) {
-        let mut acted = <T::M as Mask>::NONE;
-        let colliders = &self.rig.link_colliders[lp.colliders.clone()];
-        for &c in colliders {
-            let shape = &self.plan.colliders[c].1;
-            let pl = Placed::<T>::of(&placed[c]);
-            if let Some((dir, dist, hit)) = contact(shape, &pl, tail, lp.hit_radius) {
-                let pushed =
-                    position + (tail - dir * dist - position).normalize_or(rest_dir) * length;
-                tail = V3::select(hit, pushed, tail);
-                acted = acted.or(hit);
-            }
-        }
-        if exact {
-            let zero = T::splat(0.0);
-            for _ in 0..2 {
-                let mut changed = <T::M as Mask>::NONE;
-                for &c in colliders {
-                    let shape = &self.plan.colliders[c].1;
-                    let pl = Placed::<T>::of(&placed[c]);
-                    let Some(before) = penetration(shape, &pl, tail, lp.hit_radius) else {
-                        continue;
-                    };
-                    let inside = zero.lt(before);
-                    if !inside.any() {
-                        continue;
-                    }
-                    let t = settle_one(shape, &pl, position, length, tail, lp.hit_radius);
-                    let after = match penetration(shape, &pl, t, lp.hit_radius) {
-                        Some(p) => p,
-                        None => T::splat(f32::NEG_INFINITY),
-                    };
-                    let better = inside.and(after.lt(before));
-                    changed = changed.or(better.and(differs(t, tail)));
-                    tail = V3::select(better, t, tail);
-                }
-                acted = acted.or(changed);
-                if !changed.any() {
-                    break;
-                }
-            }
-        }
-        (tail, acted)
+        collide_tail(
+            &self.rig.link_colliders[lp.colliders.clone()],
+            &self.plan.colliders,
+            placed,
+            T::splat(lp.hit_radius),
+            position,
+            length,
+            rest_dir,
+            tail,
+            exact,
+        )
     }
 
     /// Fixed mode: whole steps of `1/step_rate` up to now for the lanes not reset, each

@@ -42,6 +42,10 @@ pub struct VrmLink {
 }
 
 /// VRM spring bones compiled for one skeleton. Shareable between characters.
+///
+/// The fields describe the compiled rig: read them; to change a parameter, compile again
+/// with [`VrmRig::new`] (the plans derived from them, such as the SIMD lane rows, are made
+/// there).
 #[derive(Debug, Clone, PartialEq)]
 pub struct VrmRig {
     /// Links in processing order (ascending joint index: every ancestor before its
@@ -56,6 +60,8 @@ pub struct VrmRig {
     pub options: VrmOptions,
     /// The file's node constraints, in evaluation order.
     pub(crate) constraints: super::constraint::CompiledConstraints,
+    /// The links as SIMD lane rows (several springs side by side), where the rig allows.
+    pub(crate) lanes: Option<crate::crowd::spring_lanes::SpringLanes>,
     joint_count: usize,
 }
 
@@ -107,7 +113,7 @@ impl VrmRig {
         // Ancestors first: the skeleton is depth-first, so a stable sort by joint index
         // puts every joint after all of its ancestors (within and across springs).
         links.sort_by_key(|l| l.joint);
-        Ok(Self {
+        let mut rig = Self {
             links,
             colliders: bones.colliders.iter().map(|c| (c.joint, c.shape)).collect(),
             link_colliders,
@@ -116,13 +122,24 @@ impl VrmRig {
                 skeleton,
                 &bones.node_constraints,
             )?,
+            lanes: None,
             joint_count: skeleton.len(),
-        })
+        };
+        rig.lanes = crate::crowd::spring_lanes::SpringLanes::new(skeleton, &rig);
+        Ok(rig)
     }
 
     /// Number of skeleton joints the rig was compiled for.
     pub fn joint_count(&self) -> usize {
         self.joint_count
+    }
+
+    /// How many lane groups (up to eight springs side by side in SIMD lanes) the update
+    /// runs in; 0 when the rig's shape keeps it on the scalar update (a spring joint at a
+    /// skeleton root, a spring hanging below a simulated joint that is not itself a
+    /// spring joint, a centre that a spring moves). Either way the results are the same.
+    pub fn lane_groups(&self) -> usize {
+        self.lanes.as_ref().map_or(0, |l| l.groups())
     }
 
     /// True when nothing is simulated.

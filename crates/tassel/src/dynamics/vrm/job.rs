@@ -4,6 +4,9 @@
 use super::collide::PlacedVrmCollider;
 use super::compile::{VrmLink, VrmRig};
 use super::settings::VrmMode;
+use crate::crowd::spring_lanes::SpringIo;
+use crate::crowd::vrm_contact::Placed;
+use crate::crowd::SimdUse;
 use crate::dynamics::path::CharacterPath;
 use crate::error::{Error, Result};
 use crate::math::{normalize_or, rotation_arc, slerp_shortest, Transform};
@@ -33,6 +36,9 @@ pub struct VrmState {
     accumulator: f32,
     needs_reset: bool,
     resets: u64,
+    /// Scratch of the lane path: each collider as placed for the step, in every lane.
+    lane_placed: Vec<Placed>,
+    simd: SimdUse,
 }
 
 impl VrmState {
@@ -60,7 +66,22 @@ impl VrmState {
             accumulator: 0.0,
             needs_reset: true,
             resets: 0,
+            lane_placed: vec![Placed::default(); rig.colliders.len()],
+            simd: SimdUse::default(),
         }
+    }
+
+    /// Which code runs the specification's update: by default several springs side by
+    /// side in SIMD lanes (with AVX2 where the CPU has it) where the rig allows it, else
+    /// the scalar code. Every choice gives the same bits; [`SimdUse::Scalar`] is the
+    /// readable reference.
+    pub fn set_simd(&mut self, simd: SimdUse) {
+        self.simd = simd;
+    }
+
+    /// The code chosen by [`VrmState::set_simd`].
+    pub fn simd(&self) -> SimdUse {
+        self.simd
     }
 
     /// Makes the next frame start again from its pose (the spec's `reset`).
@@ -379,6 +400,27 @@ fn update(
     locals: &mut [Transform],
     models: &mut [Transform],
 ) {
+    if let (Some(lanes), true) = (&rig.lanes, state.simd != SimdUse::Scalar) {
+        // The same results, several springs at a time (`crowd/spring_lanes.rs`); the
+        // models of joints that are not links are left stale: every caller recomputes
+        // the whole model pose before reading them.
+        let mut io = SpringIo {
+            component: *component,
+            dt,
+            mode,
+            locals,
+            models,
+            placed: &state.placed,
+            lane_placed: &mut state.lane_placed,
+            current_tail: &mut state.current_tail,
+            prev_tail: &mut state.prev_tail,
+            length: &state.length,
+            stale_tail: &state.stale_tail,
+            rotation: &mut state.rotation,
+        };
+        lanes.update(rig, &mut io, state.simd == SimdUse::Auto);
+        return;
+    }
     let exact = mode == VrmMode::Fixed;
     // Model transforms at or above this index are stale (a rotation above them changed).
     let mut stale_from = sk.len();

@@ -1,0 +1,425 @@
+//! One character's VRM spring bones with up to [`LANES`] springs side by side: the
+//! specification's update of [`crate::dynamics::vrm::VrmJob`] (`update` in
+//! `dynamics/vrm/job.rs`, the readable reference) with the links of different springs in
+//! the lanes of one SIMD register, each lane repeating the scalar operations, so that the
+//! results are the scalar path's bit for bit.
+//!
+//! **Why this order is the scalar order's result.** The scalar update visits links in
+//! joint order and refreshes the model transforms lazily. A link reads its parent's and
+//! its own model (both composed from the links above it), its centre's model and its own
+//! state, and writes its rotation and model. So any order in which every link comes after
+//! the links above it gives the same values. The plan holds the springs as *columns*
+//! (each link's parent is the link before it in its column) and puts up to eight columns
+//! with the same colliders and centre in a *group*; a group's row `d` is the `d`-th link of
+//! each of its columns. A column that hangs below another column's link (a branching
+//! spring) goes to a later group ([`Group`]s are in order of that depth).
+//!
+//! **What it does not take** (the job runs the scalar update instead, [`SpringLanes::new`]
+//! says `None`): a link at a skeleton root, a link whose parent is a simulated joint's
+//! descendant but not itself a link, a centre that a link can move, and a skeleton root
+//! between the first and the last link (the scalar refresh takes a root's local as its
+//! model there, the pose jobs compose it under the identity).
+
+#[cfg(target_arch = "x86_64")]
+use super::avx::Fa;
+use super::lanes::{rotation_arc_from_lanes, Lane, Mask, Trs, F, LANES, M, Q, V3};
+use super::vrm_contact::{collide_tail, Placed};
+use crate::dynamics::vrm::{PlacedVrmCollider, VrmMode, VrmRig};
+use crate::math::{normalize_or, Transform};
+use crate::skeleton::Skeleton;
+use glam::{Quat, Vec3};
+use std::ops::Range;
+
+/// The rig's links as lane rows, compiled once with the rig.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct SpringLanes {
+    groups: Vec<Group>,
+}
+
+/// Up to [`LANES`] columns with the same colliders and centre.
+#[derive(Debug, Clone, PartialEq)]
+struct Group {
+    center: Option<usize>,
+    /// The colliders of every link of the group (a range of the rig's `link_colliders`).
+    colliders: Range<usize>,
+    rows: Vec<Row>,
+}
+
+/// The `d`-th link of each column of a group, with its parameters per lane (computed
+/// with the scalar code's own operations).
+#[derive(Debug, Clone, PartialEq)]
+struct Row {
+    /// Lanes in use: columns are sorted longest first, so they are the first `n`. The
+    /// other lanes repeat lane 0's link and are never written back.
+    n: usize,
+    link: [usize; LANES],
+    joint: [usize; LANES],
+    /// Each lane's parent joint (the first row reads its model from the pose; later rows
+    /// take the row before's new models).
+    parent: [usize; LANES],
+    rest_local: Trs,
+    /// `rest_local.rotation * bone_axis`.
+    rest_bone: V3,
+    bone_axis: V3,
+    /// `normalize_or(bone_axis, Y)` and its half-turn quaternion.
+    arc_from: V3,
+    half_turn: Q,
+    /// `1 − drag_force`.
+    keep: F,
+    hit_radius: F,
+    stiffness: F,
+    gravity: V3,
+    /// Lanes whose tail is a joint (three-vrm mode re-measures their length).
+    tail_joint: M,
+}
+
+/// What one update reads and writes: the job's pose and its state's arrays.
+pub(crate) struct SpringIo<'a> {
+    pub(crate) component: Transform,
+    pub(crate) dt: f32,
+    pub(crate) mode: VrmMode,
+    pub(crate) locals: &'a mut [Transform],
+    pub(crate) models: &'a mut [Transform],
+    pub(crate) placed: &'a [PlacedVrmCollider],
+    /// Scratch, one per rig collider: the placed colliders in every lane.
+    pub(crate) lane_placed: &'a mut [Placed],
+    pub(crate) current_tail: &'a mut [Vec3],
+    pub(crate) prev_tail: &'a mut [Vec3],
+    pub(crate) length: &'a [f32],
+    pub(crate) stale_tail: &'a [Vec3],
+    pub(crate) rotation: &'a mut [Quat],
+}
+
+/// A column in the making: its links and how many columns it hangs below.
+struct Column {
+    links: Vec<usize>,
+    level: usize,
+}
+
+impl SpringLanes {
+    /// The plan for `rig`, or `None` where the lanes cannot give the scalar order's
+    /// results (see the module's documentation) or there is nothing to simulate.
+    pub(crate) fn new(sk: &Skeleton, rig: &VrmRig) -> Option<SpringLanes> {
+        let links = &rig.links;
+        let (first, last) = (links.first()?.joint, links.last()?.joint);
+        let n = sk.len();
+        if (first + 1..=last).any(|k| sk.parent(k).is_none()) {
+            return None;
+        }
+        let mut link_at = vec![None; n];
+        for (i, l) in links.iter().enumerate() {
+            if l.joint >= n || link_at[l.joint].is_some() {
+                return None;
+            }
+            link_at[l.joint] = Some(i);
+        }
+        let mut affected = vec![false; n];
+        for j in 0..n {
+            affected[j] = link_at[j].is_some() || sk.parent(j).is_some_and(|p| affected[p]);
+        }
+        let colliders_of = |i: usize| &rig.link_colliders[links[i].colliders.clone()];
+        let same_group = |a: usize, b: usize| {
+            links[a].center == links[b].center && colliders_of(a) == colliders_of(b)
+        };
+        let mut columns: Vec<Column> = Vec::new();
+        let mut column_of = vec![usize::MAX; links.len()];
+        for (i, l) in links.iter().enumerate() {
+            let p = l.parent?;
+            if sk.parent(l.joint) != Some(p) || l.center.is_some_and(|c| affected[c]) {
+                return None;
+            }
+            let level = match link_at[p] {
+                Some(pi) => {
+                    let c = column_of[pi];
+                    if columns[c].links.last() == Some(&pi) && same_group(pi, i) {
+                        columns[c].links.push(i);
+                        column_of[i] = c;
+                        continue;
+                    }
+                    columns[c].level + 1
+                }
+                // A parent below a link that is not a link itself: its model would need
+                // the lazy refresh's order.
+                None if affected[p] => return None,
+                None => 0,
+            };
+            column_of[i] = columns.len();
+            columns.push(Column {
+                links: vec![i],
+                level,
+            });
+        }
+        // Shallow levels first; within one, columns with the same colliders and centre
+        // together, longest first (so that a row's lanes in use are a prefix).
+        let mut order: Vec<usize> = (0..columns.len()).collect();
+        order.sort_by(|&a, &b| {
+            let (ca, cb) = (&columns[a], &columns[b]);
+            let (la, lb) = (ca.links[0], cb.links[0]);
+            (ca.level, links[la].center, colliders_of(la))
+                .cmp(&(cb.level, links[lb].center, colliders_of(lb)))
+                .then(cb.links.len().cmp(&ca.links.len()))
+        });
+        let mut groups = Vec::new();
+        let mut start = 0;
+        while start < order.len() {
+            let head = &columns[order[start]];
+            let mut end = start + 1;
+            while end < order.len()
+                && end - start < LANES
+                && columns[order[end]].level == head.level
+                && same_group(columns[order[end]].links[0], head.links[0])
+            {
+                end += 1;
+            }
+            let members: Vec<&Column> = order[start..end].iter().map(|&c| &columns[c]).collect();
+            groups.push(Group::new(sk, rig, &members));
+            start = end;
+        }
+        Some(SpringLanes { groups })
+    }
+
+    /// How many lane groups the update runs.
+    pub(crate) fn groups(&self) -> usize {
+        self.groups.len()
+    }
+
+    /// The scalar update's results for every link (its tails, rotations, and the links'
+    /// local rotations and model transforms in the pose; other joints' models are left
+    /// as they were, the job recomputes them), computed with AVX2 where `avx2` allows it
+    /// and the CPU has it.
+    pub(crate) fn update(&self, rig: &VrmRig, io: &mut SpringIo<'_>, avx2: bool) {
+        #[cfg(target_arch = "x86_64")]
+        if avx2 && std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: `update_avx2` only requires the AVX2 instructions, and the CPU was
+            // just checked to have them.
+            #[allow(unsafe_code)]
+            unsafe {
+                return self.update_avx2(rig, io);
+            }
+        }
+        let _ = avx2;
+        self.update_baseline(rig, io)
+    }
+
+    #[inline(never)]
+    fn update_baseline(&self, rig: &VrmRig, io: &mut SpringIo<'_>) {
+        self.update_lanes::<F>(rig, io)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    #[inline(never)]
+    fn update_avx2(&self, rig: &VrmRig, io: &mut SpringIo<'_>) {
+        // The explicit AVX lane type only inside this function, after the CPU was found
+        // to have AVX2 (the condition of its soundness, `crowd/avx.rs`).
+        self.update_lanes::<Fa>(rig, io)
+    }
+
+    #[inline(always)]
+    fn update_lanes<T: Lane>(&self, rig: &VrmRig, io: &mut SpringIo<'_>) {
+        let comp = Trs::<T>::of(&Trs::splat(&io.component));
+        let dt = T::splat(io.dt);
+        let exact = io.mode == VrmMode::Fixed;
+        let three_vrm = io.mode == VrmMode::ThreeVrm;
+        for (lp, p) in io.lane_placed.iter_mut().zip(io.placed) {
+            *lp = placed_in_lanes(p);
+        }
+        for g in &self.groups {
+            // The scalar code's `component * models[c]`, the same for every lane.
+            let center = match g.center {
+                Some(c) => Some(Trs::<T>::of(&Trs::splat(&(io.component * io.models[c])))),
+                None => None,
+            };
+            let colliders = &rig.link_colliders[g.colliders.clone()];
+            let mut above = Trs::<T>::of(&Trs::splat(&Transform::IDENTITY));
+            for (d, row) in g.rows.iter().enumerate() {
+                let parent = if d == 0 {
+                    Trs::<T>::of(&gather(io.models, &row.parent))
+                } else {
+                    above
+                };
+                let local = Trs::<T>::of(&gather(io.locals, &row.joint));
+                let parent_world = comp.mul(&parent);
+                // The joint's model translation (`models[p] * locals[j]`), then world.
+                let own_t = parent.transform_point(local.t);
+                let position = comp.transform_point(own_t);
+                let mut stored = (V3::splat(Vec3::ZERO), V3::splat(Vec3::ZERO));
+                let mut length = F::splat(0.0);
+                for l in 0..LANES {
+                    let i = row.link[l];
+                    stored.0.set(l, io.current_tail[i]);
+                    stored.1.set(l, io.prev_tail[i]);
+                    length.0[l] = io.length[i];
+                }
+                let (current_stored, prev_stored) = (V3::<T>::of(stored.0), V3::<T>::of(stored.1));
+                let (current, prev) = match &center {
+                    Some(c) => (
+                        c.transform_point(current_stored),
+                        c.transform_point(prev_stored),
+                    ),
+                    None => (current_stored, prev_stored),
+                };
+                let rest_dir = parent_world.r.mul_vec3(V3::of(row.rest_bone));
+                let inertia = (current - prev) * T::of(row.keep);
+                let stiffness = rest_dir * (T::of(row.stiffness) * dt);
+                let external = V3::<T>::of(row.gravity) * dt;
+                let mut length = T::of(length);
+                if three_vrm {
+                    let mut stale = V3::splat(Vec3::ZERO);
+                    for l in 0..LANES {
+                        stale.set(l, io.stale_tail[row.link[l]]);
+                    }
+                    let measured = (V3::<T>::of(stale) - position).length();
+                    length = T::select(<T::M as Mask>::of(row.tail_joint), measured, length);
+                }
+                let next = position
+                    + (current + inertia + stiffness + external - position).normalize_or(rest_dir)
+                        * length;
+                let (next, _) = collide_tail(
+                    colliders,
+                    &rig.colliders,
+                    io.lane_placed,
+                    T::of(row.hit_radius),
+                    position,
+                    length,
+                    rest_dir,
+                    next,
+                    exact,
+                );
+                let new_stored = match &center {
+                    Some(c) => c.inverse_transform_point(next),
+                    None => next,
+                };
+                // Turn the joint toward the tail, from its rest frame under the parent.
+                let rest_local = Trs::<T>::of(&row.rest_local);
+                let rest_world = parent_world.mul(&rest_local);
+                let to = rest_world
+                    .inverse_transform_point(next)
+                    .normalize_or(V3::of(row.bone_axis));
+                let arc = rotation_arc_from_lanes(V3::of(row.arc_from), Q::of(row.half_turn), to);
+                let rotation = rest_local.r.mul_quat(arc).normalize();
+                // `models[p] * locals[j]` with the new rotation; its translation is `own_t`.
+                let model = Trs {
+                    t: own_t,
+                    r: parent.r.mul_quat(rotation).normalize(),
+                    s: parent.s * local.s,
+                };
+                let (new_stored, rotation_f, model_f) = (new_stored.f(), rotation.f(), model.f());
+                for l in 0..row.n {
+                    let (i, j) = (row.link[l], row.joint[l]);
+                    io.prev_tail[i] = io.current_tail[i];
+                    io.current_tail[i] = new_stored.get(l);
+                    io.rotation[i] = rotation_f.get(l);
+                    io.locals[j].rotation = rotation_f.get(l);
+                    io.models[j] = model_f.get(l);
+                }
+                above = model;
+            }
+        }
+    }
+}
+
+impl Group {
+    fn new(sk: &Skeleton, rig: &VrmRig, columns: &[&Column]) -> Group {
+        let head = &rig.links[columns[0].links[0]];
+        let depth = columns.iter().map(|c| c.links.len()).max().unwrap_or(0);
+        let rows = (0..depth)
+            .map(|d| {
+                let n = columns.iter().take_while(|c| c.links.len() > d).count();
+                let mut link = [columns[0].links[d]; LANES];
+                for (l, c) in columns.iter().take(n).enumerate() {
+                    link[l] = c.links[d];
+                }
+                Row::new(sk, rig, n, link)
+            })
+            .collect();
+        Group {
+            center: head.center,
+            colliders: head.colliders.clone(),
+            rows,
+        }
+    }
+}
+
+impl Row {
+    fn new(sk: &Skeleton, rig: &VrmRig, n: usize, link: [usize; LANES]) -> Row {
+        let id = Trs::splat(&Transform::IDENTITY);
+        let zero = V3::splat(Vec3::ZERO);
+        let mut row = Row {
+            n,
+            link,
+            joint: [0; LANES],
+            parent: [0; LANES],
+            rest_local: id,
+            rest_bone: zero,
+            bone_axis: zero,
+            arc_from: zero,
+            half_turn: Q::splat(Quat::IDENTITY),
+            keep: F::splat(0.0),
+            hit_radius: F::splat(0.0),
+            stiffness: F::splat(0.0),
+            gravity: zero,
+            tail_joint: M::from_bools([false; LANES]),
+        };
+        let mut tail_joint = [false; LANES];
+        for (lane, &i) in link.iter().enumerate() {
+            let l = &rig.links[i];
+            row.joint[lane] = l.joint;
+            row.parent[lane] = sk.parent(l.joint).unwrap_or(0);
+            row.rest_local.set(lane, &l.rest_local);
+            row.rest_bone.set(lane, l.rest_local.rotation * l.bone_axis);
+            row.bone_axis.set(lane, l.bone_axis);
+            let a = normalize_or(l.bone_axis, Vec3::Y);
+            let o = a.any_orthonormal_vector();
+            row.arc_from.set(lane, a);
+            row.half_turn.set(lane, Quat::from_xyzw(o.x, o.y, o.z, 0.0));
+            row.keep.0[lane] = 1.0 - l.drag_force;
+            row.hit_radius.0[lane] = l.hit_radius;
+            row.stiffness.0[lane] = l.stiffness;
+            row.gravity.set(lane, l.gravity);
+            tail_joint[lane] = l.tail_joint.is_some();
+        }
+        row.tail_joint = M::from_bools(tail_joint);
+        row
+    }
+}
+
+/// `transforms[index[l]]` in lane `l`.
+#[inline(always)]
+fn gather(transforms: &[Transform], index: &[usize; LANES]) -> Trs {
+    let mut t = Trs::splat(&Transform::IDENTITY);
+    for (l, &k) in index.iter().enumerate() {
+        t.set(l, &transforms[k]);
+    }
+    t
+}
+
+/// A scalar placed collider in every lane (with the bounding sphere of the crowd's quick
+/// rejection, computed as the crowd does).
+fn placed_in_lanes(p: &PlacedVrmCollider) -> Placed {
+    let zero = V3::splat(Vec3::ZERO);
+    match *p {
+        PlacedVrmCollider::Sphere { center, .. } => Placed {
+            a: V3::splat(center),
+            b: zero,
+            mid: V3::splat(center),
+            half: F::splat(0.0),
+        },
+        PlacedVrmCollider::Capsule { head, tail, .. } => {
+            let (a, b) = (V3::splat(head), V3::splat(tail));
+            let half = F::splat(0.5);
+            Placed {
+                a,
+                b,
+                mid: (a + b) * half,
+                half: (b - a).length() * half,
+            }
+        }
+        PlacedVrmCollider::Plane { point, normal } => Placed {
+            a: V3::splat(point),
+            b: V3::splat(normal),
+            mid: V3::splat(point),
+            half: F::splat(0.0),
+        },
+    }
+}
