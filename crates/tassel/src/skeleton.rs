@@ -28,6 +28,9 @@ pub struct Skeleton {
     parents: Vec<u16>,
     rest: Vec<Transform>,
     index: HashMap<String, u16>,
+    /// Every joint once, by depth (roots first), skeleton order within a depth: parents
+    /// before children, and joints next to each other independent of each other.
+    level_order: Vec<u16>,
 }
 
 impl Skeleton {
@@ -84,12 +87,28 @@ impl Skeleton {
                 )));
             }
         }
+        let mut depth = vec![0u16; n];
+        for i in 0..n {
+            if packed[i] != NO_PARENT {
+                depth[i] = depth[packed[i] as usize] + 1;
+            }
+        }
+        let mut level_order: Vec<u16> = (0..n as u16).collect();
+        level_order.sort_by_key(|&i| depth[i as usize]);
         Ok(Self {
             names,
             parents: packed,
             rest,
             index,
+            level_order,
         })
+    }
+
+    /// Every joint once, shallowest first (skeleton order within a depth): an order with
+    /// every parent before its children in which neighbours do not depend on each other,
+    /// so that a pass over it is not one long chain of dependent operations.
+    pub(crate) fn level_order(&self) -> &[u16] {
+        &self.level_order
     }
 
     /// Number of joints.

@@ -34,6 +34,9 @@ use std::ops::Range;
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct SpringLanes {
     groups: Vec<Group>,
+    /// Joints below a link that are not links, in skeleton order: the update leaves their
+    /// models stale.
+    below: Vec<usize>,
 }
 
 /// Up to [`LANES`] columns with the same colliders and centre.
@@ -175,7 +178,28 @@ impl SpringLanes {
             groups.push(Group::new(sk, rig, &members));
             start = end;
         }
-        Some(SpringLanes { groups })
+        let below = (0..n)
+            .filter(|&j| affected[j] && link_at[j].is_none())
+            .collect();
+        Some(SpringLanes { groups, below })
+    }
+
+    /// After an update: the models of the joints below the links, from their parents'
+    /// (every such joint has a parent, and parents come first). With the links' models
+    /// written by the update and the other joints' untouched, `models` is then the model
+    /// pose of `locals` as [`crate::pose::LocalToModelJob`] computes it, bit for bit,
+    /// when it was before the update.
+    pub(crate) fn refresh_below(
+        &self,
+        sk: &Skeleton,
+        locals: &[Transform],
+        models: &mut [Transform],
+    ) {
+        for &k in &self.below {
+            if let Some(p) = sk.parent(k) {
+                models[k] = models[p] * locals[k];
+            }
+        }
     }
 
     /// How many lane groups the update runs.

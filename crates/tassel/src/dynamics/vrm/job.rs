@@ -165,7 +165,9 @@ pub struct VrmJob<'a> {
     pub dt: f32,
     /// In: animated local transforms. Out: with simulated rotations.
     pub locals: &'a mut [Transform],
-    /// In: animated model transforms. Out: recomputed from the new locals.
+    /// In: animated model transforms, the model pose of `locals` (as
+    /// [`LocalToModelJob`] computes it with the identity above the roots). Out: the model
+    /// pose of the new locals (joints no spring moves may keep the models given).
     pub models: &'a mut [Transform],
 }
 
@@ -228,6 +230,9 @@ impl VrmJob<'_> {
                 state.needs_reset = true;
             }
         }
+        // Whether the lane path updated every link's model (then only the joints below
+        // the links need their models recomputed at the end).
+        let mut lanes_ran = false;
         if state.needs_reset {
             reset(skeleton, rig, state, &component, locals, models);
         } else {
@@ -235,7 +240,7 @@ impl VrmJob<'_> {
                 VrmMode::Spec | VrmMode::ThreeVrm => {
                     if dt > 0.0 {
                         place_colliders(rig, state, &component, models);
-                        update(
+                        lanes_ran = update(
                             skeleton, rig, state, &component, dt, opts.mode, locals, models,
                         );
                     }
@@ -249,6 +254,7 @@ impl VrmJob<'_> {
             || state.rotation.iter().any(|q| !q.is_finite())
         {
             reset(skeleton, rig, state, &component, locals, models);
+            lanes_ran = false;
         }
         state.prev_locals.copy_from_slice(locals);
         state.prev_component = component;
@@ -268,13 +274,19 @@ impl VrmJob<'_> {
                 slerp_shortest(state.rotation_before[i], state.rotation[i], w)
             };
         }
-        LocalToModelJob {
-            skeleton,
-            root: Transform::IDENTITY,
-            locals,
-            models,
+        match (&rig.lanes, lanes_ran && rig.constraints.list.is_empty()) {
+            // The links' models are those of their new rotations already (the lane path
+            // composes them as this pass would), the joints no link moves keep the models
+            // given: only the joints below the links are left.
+            (Some(lanes), true) => lanes.refresh_below(skeleton, locals, models),
+            _ => LocalToModelJob {
+                skeleton,
+                root: Transform::IDENTITY,
+                locals,
+                models,
+            }
+            .run()?,
         }
-        .run()?;
         if opts.mode == VrmMode::Fixed && !rig.link_colliders.is_empty() {
             // The interpolated pose lags a step and may cut through a collider between
             // two steps: it is pushed out by this frame's colliders like a step's tail.
@@ -388,7 +400,8 @@ fn place_colliders(
 /// One update of every link with time step `dt` (the specification's procedure; in fixed
 /// mode with the settling after the pushes; in three-vrm mode with the bone length to the
 /// tail's place at the end of the last frame): `models` must be the model pose of
-/// `locals`; both are updated as rotations are written.
+/// `locals`; both are updated as rotations are written. Returns whether the lane path ran
+/// (then only the links' models are updated; the joints below them are left stale).
 #[allow(clippy::too_many_arguments)]
 fn update(
     sk: &Skeleton,
@@ -399,7 +412,7 @@ fn update(
     mode: VrmMode,
     locals: &mut [Transform],
     models: &mut [Transform],
-) {
+) -> bool {
     if let (Some(lanes), true) = (&rig.lanes, state.simd != SimdUse::Scalar) {
         // The same results, several springs at a time (`crowd/spring_lanes.rs`); the
         // models of joints that are not links are left stale: every caller recomputes
@@ -419,7 +432,7 @@ fn update(
             rotation: &mut state.rotation,
         };
         lanes.update(rig, &mut io, state.simd == SimdUse::Auto);
-        return;
+        return true;
     }
     let exact = mode == VrmMode::Fixed;
     // Model transforms at or above this index are stale (a rotation above them changed).
@@ -463,6 +476,7 @@ fn update(
     if stale_from < sk.len() {
         refresh(sk, locals, models, stale_from, sk.len() - 1);
     }
+    false
 }
 
 /// The world transform of the link's parent (the character's at a skeleton root).
@@ -564,6 +578,18 @@ fn settle(
 
 /// Model transforms `from..=to` recomputed from their parents' and their locals.
 fn refresh(sk: &Skeleton, locals: &[Transform], models: &mut [Transform], from: usize, to: usize) {
+    if from == 0 && to + 1 == sk.len() {
+        // The whole pose: by depth, as `LocalToModelJob` does (the same values; the joints
+        // of one depth are independent, so their compositions overlap).
+        for &k in sk.level_order() {
+            let k = usize::from(k);
+            models[k] = match sk.parent(k) {
+                Some(p) => models[p] * locals[k],
+                None => locals[k],
+            };
+        }
+        return;
+    }
     for k in from..=to {
         models[k] = match sk.parent(k) {
             Some(p) => models[p] * locals[k],
