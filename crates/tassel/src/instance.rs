@@ -150,17 +150,21 @@ impl CharacterSim {
             }
             .run()?;
         }
-        ChainJob {
-            skeleton: &self.rig.skeleton,
-            rig: &self.rig.chains,
-            state: &mut self.state,
-            component,
-            dt,
-            locals: &mut self.pose.locals,
-            models: &mut self.pose.models,
-            level: self.level.as_deref(),
+        // Every solver leaves `models` the model pose of `locals`: one without work is
+        // skipped (a chain job without chains would only compose the pose again).
+        if !self.rig.chains.chains.is_empty() {
+            ChainJob {
+                skeleton: &self.rig.skeleton,
+                rig: &self.rig.chains,
+                state: &mut self.state,
+                component,
+                dt,
+                locals: &mut self.pose.locals,
+                models: &mut self.pose.models,
+                level: self.level.as_deref(),
+            }
+            .run()?;
         }
-        .run()?;
         if !self.rig.springs.is_empty() {
             SpringJob {
                 skeleton: &self.rig.skeleton,

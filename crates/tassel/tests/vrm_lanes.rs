@@ -114,7 +114,8 @@ const MODES: [(VrmMode, f32); 4] = [
 /// idle in a group's later rows), two sets of colliders (every shape, inside and out, one
 /// collider listed twice), two centres, per-joint parameters that differ from lane to
 /// lane, tails as joints and as offsets, and a spring that branches: spring "b" turns
-/// `b0`, `b1`, `b2`, `b3`, spring "y" turns `y2`, `y3`, which hang below `b1`.
+/// `b0`, `b1`, `b2`, `b3`, spring "y" turns `y2`, `y3`, which hang below `b1`; joints
+/// below spring joints that no spring turns (tails, an ornament with a child).
 fn every_part() -> (Skeleton, VrmSpringBones) {
     let mut b = SkeletonBuilder::new();
     let root = b.add("root", None, Transform::IDENTITY);
@@ -141,6 +142,27 @@ fn every_part() -> (Skeleton, VrmSpringBones) {
                 Transform::from_translation(dir * 0.06),
             );
             joints.push(p);
+            if c == 5 && k == 2 {
+                // An ornament below a spring joint that no spring turns, with a child.
+                let o = b.add(
+                    "ornament",
+                    Some(p),
+                    Transform::from_translation(Vec3::X * 0.03),
+                );
+                b.add(
+                    "ornament_tip",
+                    Some(o),
+                    Transform::from_translation(Vec3::X * 0.02),
+                );
+            }
+        }
+        if c % 3 == 0 {
+            // A tail joint that no spring turns.
+            b.add(
+                format!("h{c}_tail"),
+                Some(p),
+                Transform::from_translation(dir * 0.05),
+            );
         }
         chains.push(joints);
     }
@@ -207,9 +229,10 @@ fn every_part() -> (Skeleton, VrmSpringBones) {
             .enumerate()
             .map(|(k, &j)| VrmJoint {
                 joint: j,
-                tail: match joints.get(k + 1) {
-                    Some(&t) => VrmTail::Joint(t),
-                    None => VrmTail::Local(Vec3::new(0.0, -0.05, 0.02)),
+                tail: match (joints.get(k + 1), sk.children(j).last()) {
+                    (Some(&t), _) => VrmTail::Joint(t),
+                    (None, Some(t)) => VrmTail::Joint(t),
+                    (None, None) => VrmTail::Local(Vec3::new(0.0, -0.05, 0.02)),
                 },
                 hit_radius: 0.01 + 0.005 * ((seed + k) % 3) as f32,
                 stiffness: 0.4 + 0.3 * ((seed + k) % 4) as f32,

@@ -1084,6 +1084,30 @@ impl<T: Lane> V3<T> {
     }
 }
 
+/// `out[k] = a[k].lerp(&b[k], t)` for every `k` ([`Transform::lerp`]'s bits), eight
+/// transforms at a time. The slices have the same length.
+pub(crate) fn lerp_transforms(a: &[Transform], b: &[Transform], t: f32, out: &mut [Transform]) {
+    let t = F::splat(t);
+    for ((a, b), out) in a
+        .chunks(LANES)
+        .zip(b.chunks(LANES))
+        .zip(out.chunks_mut(LANES))
+    {
+        let (mut la, mut lb) = (
+            Trs::splat(&Transform::IDENTITY),
+            Trs::splat(&Transform::IDENTITY),
+        );
+        for (l, (x, y)) in a.iter().zip(b).enumerate() {
+            la.set(l, x);
+            lb.set(l, y);
+        }
+        let r = la.lerp(&lb, t);
+        for (l, o) in out.iter_mut().enumerate() {
+            *o = r.get(l);
+        }
+    }
+}
+
 impl Trs {
     /// [`Transform::lerp`] per lane.
     #[inline(always)]

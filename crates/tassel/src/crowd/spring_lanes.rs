@@ -61,6 +61,8 @@ struct Row {
     /// take the row before's new models).
     parent: [usize; LANES],
     rest_local: Trs,
+    /// The tail in the joint's rest local space.
+    tail_local: V3,
     /// `rest_local.rotation * bone_axis`.
     rest_bone: V3,
     bone_axis: V3,
@@ -225,6 +227,111 @@ impl SpringLanes {
         self.update_baseline(rig, io)
     }
 
+    /// The fixed mode's output pass (`collide_output` in `dynamics/vrm/job.rs`): each
+    /// link's tail, from the output pose in `io.locals`, pushed out of the colliders and
+    /// settled, the joint turned where a collider acted; then every model below a link
+    /// recomputed. Reads `io.component`, `io.placed` and `io.length`; writes the links'
+    /// local rotations and the models.
+    pub(crate) fn collide_output(
+        &self,
+        sk: &Skeleton,
+        rig: &VrmRig,
+        io: &mut SpringIo<'_>,
+        avx2: bool,
+    ) {
+        #[cfg(target_arch = "x86_64")]
+        if avx2 && std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: as in `update`.
+            #[allow(unsafe_code)]
+            unsafe {
+                self.output_avx2(rig, io);
+            }
+            self.refresh_below(sk, io.locals, io.models);
+            return;
+        }
+        let _ = avx2;
+        self.output_baseline(rig, io);
+        self.refresh_below(sk, io.locals, io.models);
+    }
+
+    #[inline(never)]
+    fn output_baseline(&self, rig: &VrmRig, io: &mut SpringIo<'_>) {
+        self.output_lanes::<F>(rig, io)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    #[inline(never)]
+    fn output_avx2(&self, rig: &VrmRig, io: &mut SpringIo<'_>) {
+        self.output_lanes::<Fa>(rig, io)
+    }
+
+    #[inline(always)]
+    fn output_lanes<T: Lane>(&self, rig: &VrmRig, io: &mut SpringIo<'_>) {
+        let comp = Trs::<T>::of(&Trs::splat(&io.component));
+        for (lp, p) in io.lane_placed.iter_mut().zip(io.placed) {
+            *lp = placed_in_lanes(p);
+        }
+        for g in &self.groups {
+            let colliders = &rig.link_colliders[g.colliders.clone()];
+            let mut above = Trs::<T>::of(&Trs::splat(&Transform::IDENTITY));
+            for (d, row) in g.rows.iter().enumerate() {
+                let parent = if d == 0 {
+                    Trs::<T>::of(&gather(io.models, &row.parent))
+                } else {
+                    above
+                };
+                let local = Trs::<T>::of(&gather(io.locals, &row.joint));
+                // The joint's model from the output rotation (the scalar refresh's).
+                let own = parent.mul(&local);
+                let mut model = own;
+                let mut turned = None;
+                if !colliders.is_empty() {
+                    let joint_world = comp.mul(&own);
+                    let tail = joint_world.transform_point(V3::of(row.tail_local));
+                    let parent_world = comp.mul(&parent);
+                    let rest_dir = parent_world.r.mul_vec3(V3::of(row.rest_bone));
+                    let mut length = F::splat(0.0);
+                    for l in 0..LANES {
+                        length.0[l] = io.length[row.link[l]];
+                    }
+                    let (next, acted) = collide_tail(
+                        colliders,
+                        &rig.colliders,
+                        io.lane_placed,
+                        T::of(row.hit_radius),
+                        joint_world.t,
+                        T::of(length),
+                        rest_dir,
+                        tail,
+                        true,
+                    );
+                    if acted.any() {
+                        let rotation = row.turn(&parent_world, next);
+                        let new = Trs {
+                            t: own.t,
+                            r: parent.r.mul_quat(rotation).normalize(),
+                            s: own.s,
+                        };
+                        model = Trs::select(acted, &new, &own);
+                        turned = Some((acted.m(), rotation.f()));
+                    }
+                }
+                let model_f = model.f();
+                for l in 0..row.n {
+                    let j = row.joint[l];
+                    if let Some((acted, rotation)) = &turned {
+                        if acted.get(l) {
+                            io.locals[j].rotation = rotation.get(l);
+                        }
+                    }
+                    io.models[j] = model_f.get(l);
+                }
+                above = model;
+            }
+        }
+    }
+
     #[inline(never)]
     fn update_baseline(&self, rig: &VrmRig, io: &mut SpringIo<'_>) {
         self.update_lanes::<F>(rig, io)
@@ -314,14 +421,7 @@ impl SpringLanes {
                     Some(c) => c.inverse_transform_point(next),
                     None => next,
                 };
-                // Turn the joint toward the tail, from its rest frame under the parent.
-                let rest_local = Trs::<T>::of(&row.rest_local);
-                let rest_world = parent_world.mul(&rest_local);
-                let to = rest_world
-                    .inverse_transform_point(next)
-                    .normalize_or(V3::of(row.bone_axis));
-                let arc = rotation_arc_from_lanes(V3::of(row.arc_from), Q::of(row.half_turn), to);
-                let rotation = rest_local.r.mul_quat(arc).normalize();
+                let rotation = row.turn(&parent_world, next);
                 // `models[p] * locals[j]` with the new rotation; its translation is `own_t`.
                 let model = Trs {
                     t: own_t,
@@ -366,6 +466,20 @@ impl Group {
 }
 
 impl Row {
+    /// The local rotations that point the lanes' bones at `tail` (world): the rest local
+    /// rotation turned from the bone axis to the tail seen from the rest frame under the
+    /// parent (the scalar `turn_toward`).
+    #[inline(always)]
+    fn turn<T: Lane>(&self, parent_world: &Trs<T>, tail: V3<T>) -> Q<T> {
+        let rest_local = Trs::<T>::of(&self.rest_local);
+        let rest_world = parent_world.mul(&rest_local);
+        let to = rest_world
+            .inverse_transform_point(tail)
+            .normalize_or(V3::of(self.bone_axis));
+        let arc = rotation_arc_from_lanes(V3::of(self.arc_from), Q::of(self.half_turn), to);
+        rest_local.r.mul_quat(arc).normalize()
+    }
+
     fn new(sk: &Skeleton, rig: &VrmRig, n: usize, link: [usize; LANES]) -> Row {
         let id = Trs::splat(&Transform::IDENTITY);
         let zero = V3::splat(Vec3::ZERO);
@@ -375,6 +489,7 @@ impl Row {
             joint: [0; LANES],
             parent: [0; LANES],
             rest_local: id,
+            tail_local: zero,
             rest_bone: zero,
             bone_axis: zero,
             arc_from: zero,
@@ -391,6 +506,7 @@ impl Row {
             row.joint[lane] = l.joint;
             row.parent[lane] = sk.parent(l.joint).unwrap_or(0);
             row.rest_local.set(lane, &l.rest_local);
+            row.tail_local.set(lane, l.tail_local);
             row.rest_bone.set(lane, l.rest_local.rotation * l.bone_axis);
             row.bone_axis.set(lane, l.bone_axis);
             let a = normalize_or(l.bone_axis, Vec3::Y);

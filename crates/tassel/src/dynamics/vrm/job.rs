@@ -4,6 +4,7 @@
 use super::collide::PlacedVrmCollider;
 use super::compile::{VrmLink, VrmRig};
 use super::settings::VrmMode;
+use crate::crowd::lanes::lerp_transforms;
 use crate::crowd::spring_lanes::SpringIo;
 use crate::crowd::vrm_contact::Placed;
 use crate::crowd::SimdUse;
@@ -220,6 +221,11 @@ impl VrmJob<'_> {
             rig.constraints.apply(skeleton, &component, locals, models);
         }
         if rig.links.is_empty() {
+            if !rig.constraints.list.is_empty() {
+                // The constraints' refresh takes a root's local as its model; the output
+                // is the model pose as `LocalToModelJob` computes it.
+                crate::pose::local_to_model_into(skeleton, locals, models);
+            }
             return Ok(());
         }
         state.path.push(component, dt);
@@ -305,11 +311,30 @@ impl VrmJob<'_> {
 fn collide_output(
     sk: &Skeleton,
     rig: &VrmRig,
-    state: &VrmState,
+    state: &mut VrmState,
     component: &Transform,
     locals: &mut [Transform],
     models: &mut [Transform],
 ) {
+    if let (Some(lanes), true) = (&rig.lanes, state.simd != SimdUse::Scalar) {
+        // The same results, several springs at a time (`crowd/spring_lanes.rs`).
+        let mut io = SpringIo {
+            component: *component,
+            dt: 0.0,
+            mode: VrmMode::Fixed,
+            locals,
+            models,
+            placed: &state.placed,
+            lane_placed: &mut state.lane_placed,
+            current_tail: &mut state.current_tail,
+            prev_tail: &mut state.prev_tail,
+            length: &state.length,
+            stale_tail: &state.stale_tail,
+            rotation: &mut state.rotation,
+        };
+        lanes.collide_output(sk, rig, &mut io, state.simd == SimdUse::Auto);
+        return;
+    }
     let mut stale_from = sk.len();
     for (i, l) in rig.links.iter().enumerate() {
         if l.colliders.is_empty() {
@@ -339,7 +364,10 @@ fn collide_output(
         stale_from = stale_from.min(l.joint + 1);
     }
     if stale_from < sk.len() {
-        refresh(sk, locals, models, stale_from, sk.len() - 1);
+        // The whole pose as `LocalToModelJob` computes it (a skeleton root under the
+        // identity; the lazy refresh takes a root's local as its model): the job's output
+        // is the model pose of its locals.
+        crate::pose::local_to_model_into(sk, locals, models);
     }
 }
 
@@ -620,12 +648,17 @@ fn run_fixed(sk: &Skeleton, rig: &VrmRig, state: &mut VrmState, dt: f32, locals:
         } else {
             1.0
         };
-        for (s, (a, b)) in state
-            .step_locals
-            .iter_mut()
-            .zip(state.prev_locals.iter().zip(locals))
-        {
-            *s = a.lerp(b, w);
+        if state.simd == SimdUse::Scalar {
+            for (s, (a, b)) in state
+                .step_locals
+                .iter_mut()
+                .zip(state.prev_locals.iter().zip(locals))
+            {
+                *s = a.lerp(b, w);
+            }
+        } else {
+            // The same lerps, eight joints at a time.
+            lerp_transforms(&state.prev_locals, locals, w, &mut state.step_locals);
         }
         let comp = state.path.at(w);
         let mut step_locals = std::mem::take(&mut state.step_locals);
