@@ -1085,8 +1085,28 @@ impl<T: Lane> V3<T> {
 }
 
 /// `out[k] = a[k].lerp(&b[k], t)` for every `k` ([`Transform::lerp`]'s bits), eight
-/// transforms at a time. The slices have the same length.
+/// transforms at a time, compiled for AVX2 where the CPU has it. The slices have the
+/// same length.
 pub(crate) fn lerp_transforms(a: &[Transform], b: &[Transform], t: f32, out: &mut [Transform]) {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the function only requires AVX2, which the CPU was just found to have.
+        #[allow(unsafe_code)]
+        unsafe {
+            return lerp_transforms_avx2(a, b, t, out);
+        }
+    }
+    lerp_transforms_lanes(a, b, t, out)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn lerp_transforms_avx2(a: &[Transform], b: &[Transform], t: f32, out: &mut [Transform]) {
+    lerp_transforms_lanes(a, b, t, out)
+}
+
+#[inline(always)]
+fn lerp_transforms_lanes(a: &[Transform], b: &[Transform], t: f32, out: &mut [Transform]) {
     let t = F::splat(t);
     for ((a, b), out) in a
         .chunks(LANES)

@@ -273,6 +273,7 @@ impl VrmJob<'_> {
             // This frame's colliders, from the animated pose.
             place_colliders(rig, state, &component, models);
         }
+        // (The lanes' slerp, eight links at a time, measured no faster than these.)
         for (i, l) in rig.links.iter().enumerate() {
             locals[l.joint].rotation = if w >= 1.0 {
                 state.rotation[i]
