@@ -39,7 +39,8 @@ fn local_to_model(sk: &Skeleton, root: &Transform, locals: &[Transform], models:
     // By depth rather than in skeleton order: the same operations on the same values (a
     // parent is always done first), but the joints of one depth are independent, so the
     // processor overlaps their compositions instead of waiting for each (a chain's joints
-    // are neighbours in skeleton order). 1.6x faster on the bench rig's 16 chains.
+    // are neighbours in skeleton order): `tassel bench --vrm spec`, two such passes a frame,
+    // 98 -> 64 ns per joint-step on the bench rig's 16 chains.
     for &i in sk.level_order() {
         let i = usize::from(i);
         models[i] = match sk.parent(i) {
