@@ -80,6 +80,31 @@ impl VrmState {
         self.simd = simd;
     }
 
+    /// The lane path's view of a frame: the pose and this state's arrays.
+    fn lane_io<'a>(
+        &'a mut self,
+        component: &Transform,
+        dt: f32,
+        mode: VrmMode,
+        locals: &'a mut [Transform],
+        models: &'a mut [Transform],
+    ) -> SpringIo<'a> {
+        SpringIo {
+            component: *component,
+            dt,
+            mode,
+            locals,
+            models,
+            placed: &self.placed,
+            lane_placed: &mut self.lane_placed,
+            current_tail: &mut self.current_tail,
+            prev_tail: &mut self.prev_tail,
+            length: &self.length,
+            stale_tail: &self.stale_tail,
+            rotation: &mut self.rotation,
+        }
+    }
+
     /// The code chosen by [`VrmState::set_simd`].
     pub fn simd(&self) -> SimdUse {
         self.simd
@@ -319,21 +344,9 @@ fn collide_output(
 ) {
     if let (Some(lanes), true) = (&rig.lanes, state.simd != SimdUse::Scalar) {
         // The same results, several springs at a time (`crowd/spring_lanes.rs`).
-        let mut io = SpringIo {
-            component: *component,
-            dt: 0.0,
-            mode: VrmMode::Fixed,
-            locals,
-            models,
-            placed: &state.placed,
-            lane_placed: &mut state.lane_placed,
-            current_tail: &mut state.current_tail,
-            prev_tail: &mut state.prev_tail,
-            length: &state.length,
-            stale_tail: &state.stale_tail,
-            rotation: &mut state.rotation,
-        };
-        lanes.collide_output(sk, rig, &mut io, state.simd == SimdUse::Auto);
+        let avx2 = state.simd == SimdUse::Auto;
+        let mut io = state.lane_io(component, 0.0, VrmMode::Fixed, locals, models);
+        lanes.collide_output(sk, rig, &mut io, avx2);
         return;
     }
     let mut stale_from = sk.len();
@@ -446,21 +459,9 @@ fn update(
         // The same results, several springs at a time (`crowd/spring_lanes.rs`); the
         // models of joints that are not links are left stale: every caller recomputes
         // the whole model pose before reading them.
-        let mut io = SpringIo {
-            component: *component,
-            dt,
-            mode,
-            locals,
-            models,
-            placed: &state.placed,
-            lane_placed: &mut state.lane_placed,
-            current_tail: &mut state.current_tail,
-            prev_tail: &mut state.prev_tail,
-            length: &state.length,
-            stale_tail: &state.stale_tail,
-            rotation: &mut state.rotation,
-        };
-        lanes.update(rig, &mut io, state.simd == SimdUse::Auto);
+        let avx2 = state.simd == SimdUse::Auto;
+        let mut io = state.lane_io(component, dt, mode, locals, models);
+        lanes.update(rig, &mut io, avx2);
         return true;
     }
     let exact = mode == VrmMode::Fixed;
