@@ -36,16 +36,29 @@ impl Pose {
 }
 
 fn local_to_model(sk: &Skeleton, root: &Transform, locals: &[Transform], models: &mut [Transform]) {
-    // By depth rather than in skeleton order: the same operations on the same values (a
-    // parent is always done first), but the joints of one depth are independent, so the
-    // processor overlaps their compositions instead of waiting for each (a chain's joints
-    // are neighbours in skeleton order): `tassel bench --vrm spec`, two such passes a frame,
-    // 98 -> 64 ns per joint-step on the bench rig's 16 chains.
+    compose_by_depth(sk, Some(root), locals, models);
+}
+
+/// Every joint's model transform, its parent's times its local one; a root's is `root`
+/// times its local one, or (`None`) its local one as it is.
+///
+/// By depth rather than in skeleton order: the same operations on the same values (a
+/// parent is always done first), but the joints of one depth are independent, so the
+/// processor overlaps their compositions instead of waiting for each (a chain's joints
+/// are neighbours in skeleton order): `tassel bench --vrm spec`, two such passes a frame,
+/// 98 -> 64 ns per joint-step on the bench rig's 16 chains.
+pub(crate) fn compose_by_depth(
+    sk: &Skeleton,
+    root: Option<&Transform>,
+    locals: &[Transform],
+    models: &mut [Transform],
+) {
     for &i in sk.level_order() {
         let i = usize::from(i);
-        models[i] = match sk.parent(i) {
-            Some(p) => models[p] * locals[i],
-            None => *root * locals[i],
+        models[i] = match (sk.parent(i), root) {
+            (Some(p), _) => models[p] * locals[i],
+            (None, Some(root)) => *root * locals[i],
+            (None, None) => locals[i],
         };
     }
 }

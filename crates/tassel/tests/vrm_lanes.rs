@@ -110,6 +110,17 @@ const MODES: [(VrmMode, f32); 4] = [
     (VrmMode::Fixed, 90.0),
 ];
 
+/// [`assert_lanes_match`] in every mode, each with springs that really moved.
+fn assert_lanes_match_in_every_mode(sk: &Skeleton, bones: &VrmSpringBones) {
+    for mode in MODES {
+        let turned = assert_lanes_match(sk, bones, mode);
+        assert!(
+            turned > 0.05,
+            "{mode:?}: the springs barely moved ({turned} rad)"
+        );
+    }
+}
+
 /// A rig that uses every part of the lane plan: 14 hair springs of 1 to 6 joints (lanes
 /// idle in a group's later rows), two sets of colliders (every shape, inside and out, one
 /// collider listed twice), two centres, per-joint parameters that differ from lane to
@@ -276,13 +287,7 @@ fn lanes_give_the_scalar_bits_with_every_part_of_the_plan() {
     // groups); colliders "b": h6, h9, h10 (one), h7 with its centre (one), h8 with its
     // centre (one); "y" hangs below "b"'s link b1: a group of its own after them.
     assert_eq!(rig.lane_groups(), 6);
-    for mode in MODES {
-        let turned = assert_lanes_match(&sk, &bones, mode);
-        assert!(
-            turned > 0.05,
-            "{mode:?}: the springs barely moved ({turned} rad)"
-        );
-    }
+    assert_lanes_match_in_every_mode(&sk, &bones);
 }
 
 #[test]
@@ -290,13 +295,7 @@ fn lanes_give_the_scalar_bits_on_the_bench_rig() {
     let (sk, bones) = builtin::bench_vrm(16, 8, 8);
     let rig = VrmRig::new(&sk, &bones, VrmOptions::default()).unwrap();
     assert_eq!(rig.lane_groups(), 2, "16 springs with the same colliders");
-    for mode in MODES {
-        let turned = assert_lanes_match(&sk, &bones, mode);
-        assert!(
-            turned > 0.05,
-            "{mode:?}: the springs barely moved ({turned} rad)"
-        );
-    }
+    assert_lanes_match_in_every_mode(&sk, &bones);
 }
 
 /// Rigs the lanes cannot take run the scalar update (and still agree, trivially).

@@ -1085,17 +1085,24 @@ impl<T: Lane> V3<T> {
 }
 
 /// `out[k] = a[k].lerp(&b[k], t)` for every `k` ([`Transform::lerp`]'s bits), eight
-/// transforms at a time, compiled for AVX2 where the CPU has it. The slices have the
-/// same length.
-pub(crate) fn lerp_transforms(a: &[Transform], b: &[Transform], t: f32, out: &mut [Transform]) {
+/// transforms at a time, compiled for AVX2 where `avx2` allows it and the CPU has it. The
+/// slices have the same length.
+pub(crate) fn lerp_transforms(
+    a: &[Transform],
+    b: &[Transform],
+    t: f32,
+    out: &mut [Transform],
+    avx2: bool,
+) {
     #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") {
+    if avx2 && std::arch::is_x86_feature_detected!("avx2") {
         // SAFETY: the function only requires AVX2, which the CPU was just found to have.
         #[allow(unsafe_code)]
         unsafe {
             return lerp_transforms_avx2(a, b, t, out);
         }
     }
+    let _ = avx2;
     lerp_transforms_lanes(a, b, t, out)
 }
 

@@ -20,6 +20,7 @@ mod vrm;
 pub(crate) mod vrm_contact;
 
 pub use chain::ChainCrowd;
+pub use vrm::{CrowdPose, VrmCrowd};
 
 /// Which code runs a solver step that has a lane path. Every choice gives the same bits
 /// (each lane repeats the scalar operations); they differ in speed only.
@@ -33,4 +34,3 @@ pub enum SimdUse {
     #[default]
     Auto,
 }
-pub use vrm::{CrowdPose, VrmCrowd};

@@ -95,6 +95,27 @@ pub(crate) struct SpringIo<'a> {
     pub(crate) rotation: &'a mut [Quat],
 }
 
+impl SpringIo<'_> {
+    /// Every placed collider in every lane (`lane_placed`), for a pass over the groups.
+    fn place_in_lanes(&mut self) {
+        for (lp, p) in self.lane_placed.iter_mut().zip(self.placed) {
+            *lp = placed_in_lanes(p);
+        }
+    }
+
+    /// Row `d`'s parent models (the pose's for a group's first row, else `above`, the
+    /// row before's new models) and its joints' locals.
+    #[inline(always)]
+    fn row_pose<T: Lane>(&self, row: &Row, d: usize, above: Trs<T>) -> (Trs<T>, Trs<T>) {
+        let parent = if d == 0 {
+            Trs::<T>::of(&gather(self.models, &row.parent))
+        } else {
+            above
+        };
+        (parent, Trs::<T>::of(&gather(self.locals, &row.joint)))
+    }
+}
+
 /// A column in the making: its links and how many columns it hangs below.
 struct Column {
     links: Vec<usize>,
@@ -269,19 +290,12 @@ impl SpringLanes {
     #[inline(always)]
     fn output_lanes<T: Lane>(&self, rig: &VrmRig, io: &mut SpringIo<'_>) {
         let comp = Trs::<T>::of(&Trs::splat(&io.component));
-        for (lp, p) in io.lane_placed.iter_mut().zip(io.placed) {
-            *lp = placed_in_lanes(p);
-        }
+        io.place_in_lanes();
         for g in &self.groups {
             let colliders = &rig.link_colliders[g.colliders.clone()];
             let mut above = Trs::<T>::of(&Trs::splat(&Transform::IDENTITY));
             for (d, row) in g.rows.iter().enumerate() {
-                let parent = if d == 0 {
-                    Trs::<T>::of(&gather(io.models, &row.parent))
-                } else {
-                    above
-                };
-                let local = Trs::<T>::of(&gather(io.locals, &row.joint));
+                let (parent, local) = io.row_pose(row, d, above);
                 // The joint's model from the output rotation (the scalar refresh's).
                 let own = parent.mul(&local);
                 let mut model = own;
@@ -352,9 +366,7 @@ impl SpringLanes {
         let dt = T::splat(io.dt);
         let exact = io.mode == VrmMode::Fixed;
         let three_vrm = io.mode == VrmMode::ThreeVrm;
-        for (lp, p) in io.lane_placed.iter_mut().zip(io.placed) {
-            *lp = placed_in_lanes(p);
-        }
+        io.place_in_lanes();
         for g in &self.groups {
             // The scalar code's `component * models[c]`, the same for every lane.
             let center = match g.center {
@@ -364,12 +376,7 @@ impl SpringLanes {
             let colliders = &rig.link_colliders[g.colliders.clone()];
             let mut above = Trs::<T>::of(&Trs::splat(&Transform::IDENTITY));
             for (d, row) in g.rows.iter().enumerate() {
-                let parent = if d == 0 {
-                    Trs::<T>::of(&gather(io.models, &row.parent))
-                } else {
-                    above
-                };
-                let local = Trs::<T>::of(&gather(io.locals, &row.joint));
+                let (parent, local) = io.row_pose(row, d, above);
                 let parent_world = comp.mul(&parent);
                 // The joint's model translation (`models[p] * locals[j]`), then world.
                 let own_t = parent.transform_point(local.t);

@@ -72,9 +72,9 @@ impl VrmState {
         }
     }
 
-    /// Which code runs the specification's update: by default several springs side by
-    /// side in SIMD lanes (with AVX2 where the CPU has it) where the rig allows it, else
-    /// the scalar code. Every choice gives the same bits; [`SimdUse::Scalar`] is the
+    /// Which code runs the specification's update and fixed mode's output pass and step
+    /// pose: by default several springs (joints) side by side in SIMD lanes (with AVX2
+    /// where the CPU has it) where the rig allows it, else the scalar code. Every choice gives the same bits; [`SimdUse::Scalar`] is the
     /// readable reference.
     pub fn set_simd(&mut self, simd: SimdUse) {
         self.simd = simd;
@@ -609,15 +609,9 @@ fn settle(
 /// Model transforms `from..=to` recomputed from their parents' and their locals.
 fn refresh(sk: &Skeleton, locals: &[Transform], models: &mut [Transform], from: usize, to: usize) {
     if from == 0 && to + 1 == sk.len() {
-        // The whole pose: by depth, as `LocalToModelJob` does (the same values; the joints
-        // of one depth are independent, so their compositions overlap).
-        for &k in sk.level_order() {
-            let k = usize::from(k);
-            models[k] = match sk.parent(k) {
-                Some(p) => models[p] * locals[k],
-                None => locals[k],
-            };
-        }
+        // The whole pose: by depth, as `LocalToModelJob` does (the same values), a root
+        // taking its local as its model.
+        crate::pose::compose_by_depth(sk, None, locals, models);
         return;
     }
     for k in from..=to {
@@ -660,7 +654,8 @@ fn run_fixed(sk: &Skeleton, rig: &VrmRig, state: &mut VrmState, dt: f32, locals:
             }
         } else {
             // The same lerps, eight joints at a time.
-            lerp_transforms(&state.prev_locals, locals, w, &mut state.step_locals);
+            let avx2 = state.simd == SimdUse::Auto;
+            lerp_transforms(&state.prev_locals, locals, w, &mut state.step_locals, avx2);
         }
         let comp = state.path.at(w);
         let mut step_locals = std::mem::take(&mut state.step_locals);
