@@ -1,6 +1,7 @@
 //! One character's secondary-motion frame: a shared compiled rig and this character's
 //! states.
 
+use crate::animated::{AnimatedModels, AnimatedPose};
 use crate::character_rig::CharacterRig;
 use crate::controller::Level;
 use crate::dynamics::chain::{ChainJob, ChainRig, ChainState};
@@ -45,7 +46,7 @@ pub struct CharacterSim {
     ropes: Ropes,
     vrm_state: VrmState,
     pose: Pose,
-    animated_models: Vec<Transform>,
+    animated: AnimatedPose,
     component: Transform,
     level: Option<Arc<Level>>,
 }
@@ -74,7 +75,7 @@ impl CharacterSim {
     /// rig is shared, only the states are allocated.
     pub fn from_rig(rig: Arc<CharacterRig>) -> Self {
         let pose = Pose::rest(&rig.skeleton);
-        let animated_models = pose.models.clone();
+        let animated = AnimatedPose::new(&pose.models);
         Self {
             state: ChainState::new(&rig.chains),
             spring_state: SpringState::new(&rig.springs),
@@ -82,7 +83,7 @@ impl CharacterSim {
             ropes: rig.ropes.clone(),
             vrm_state: VrmState::new(&rig.vrm),
             pose,
-            animated_models,
+            animated,
             component: Transform::IDENTITY,
             level: None,
             rig,
@@ -130,14 +131,23 @@ impl CharacterSim {
         }
         self.component = component;
         self.pose.locals.copy_from_slice(animated);
-        LocalToModelJob {
-            skeleton: &self.rig.skeleton,
-            root: Transform::IDENTITY,
-            locals: &self.pose.locals,
-            models: &mut self.pose.models,
+        let sk = &self.rig.skeleton;
+        if let Some(lanes) = self.rig.vrm.lanes_for(self.vrm_state.simd()) {
+            // The VRM job composes every joint a spring moves itself before reading it:
+            // only the others are composed here (the job's output is the whole pose), and
+            // the animated models wait until asked for.
+            lanes.compose_input(sk, &self.pose.locals, &mut self.pose.models);
+            self.animated.set_locals(animated);
+        } else {
+            LocalToModelJob {
+                skeleton: sk,
+                root: Transform::IDENTITY,
+                locals: &self.pose.locals,
+                models: &mut self.pose.models,
+            }
+            .run()?;
+            self.animated.set_models(&self.pose.models);
         }
-        .run()?;
-        self.animated_models.copy_from_slice(&self.pose.models);
         if !self.rig.vrm.is_empty() {
             VrmJob {
                 skeleton: &self.rig.skeleton,
@@ -148,7 +158,7 @@ impl CharacterSim {
                 locals: &mut self.pose.locals,
                 models: &mut self.pose.models,
             }
-            .run()?;
+            .run_validated();
         }
         // Every solver leaves `models` the model pose of `locals`: one without work is
         // skipped (a chain job without chains would only compose the pose again).
@@ -329,9 +339,12 @@ impl CharacterSim {
         &self.pose
     }
 
-    /// The last animated (input) model pose.
-    pub fn animated_models(&self) -> &[Transform] {
-        &self.animated_models
+    /// The last animated (input) model pose: a slice of model transforms
+    /// (`animated_models()[joint]`, `.iter()`). Composed on first use after a frame whose
+    /// solvers did not need it whole (VRM springs in lanes compose their joints
+    /// themselves); release it before the next [`frame`](Self::frame).
+    pub fn animated_models(&self) -> AnimatedModels<'_> {
+        self.animated.models(&self.rig.skeleton)
     }
 
     /// Starts the chains again from the animated pose on the next frame.

@@ -30,6 +30,7 @@
 //! - The first frame of a run is stepped with `dt = 0` (see [`CharacterSim`]).
 
 pub mod anim;
+mod animated;
 pub mod builtin;
 mod character_rig;
 pub mod collide;
@@ -44,6 +45,7 @@ mod pose;
 pub mod rng;
 mod skeleton;
 
+pub use animated::AnimatedModels;
 pub use character_rig::CharacterRig;
 pub use error::{Error, Result};
 /// The math library Tassel's API speaks (glam 0.32), re-exported so a user needs no

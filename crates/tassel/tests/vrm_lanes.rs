@@ -9,7 +9,7 @@ use tassel::dynamics::vrm::{
     VrmSpringBones, VrmTail,
 };
 use tassel::dynamics::RigSettings;
-use tassel::{builtin, CharacterSim, Skeleton, SkeletonBuilder, Transform};
+use tassel::{builtin, CharacterSim, LocalToModelJob, Skeleton, SkeletonBuilder, Transform};
 
 /// The character's world transform and animated pose at frame `f`: a sway, a bob, a turn
 /// and a roll, joint `swing` swinging, a 10 m teleport at frame 450.
@@ -76,6 +76,17 @@ fn assert_lanes_match(
         let dt = dt_at(f);
         let reference = sims[0].frame(&locals, transform, dt).unwrap().clone();
         let resets = sims[0].vrm_state().reset_count();
+        // The animated model pose, whichever way the frame left it (composed, or composed
+        // when asked for): the pose job's, bit for bit.
+        let mut animated = vec![Transform::IDENTITY; sk.len()];
+        LocalToModelJob {
+            skeleton: sk,
+            root: Transform::IDENTITY,
+            locals: &locals,
+            models: &mut animated,
+        }
+        .run()
+        .unwrap();
         for (w, sim) in ways.iter().zip(&mut sims).skip(1) {
             let pose = sim.frame(&locals, transform, dt).unwrap();
             for j in 0..sk.len() {
@@ -89,6 +100,17 @@ fn assert_lanes_match(
                 );
             }
             assert_eq!(sim.vrm_state().reset_count(), resets);
+        }
+        for (w, sim) in ways.iter().zip(&sims) {
+            let got = sim.animated_models();
+            for j in 0..sk.len() {
+                assert_eq!(
+                    bits(&got[j]),
+                    bits(&animated[j]),
+                    "{w:?}: frame {f}, animated model of '{}'",
+                    sk.name(j)
+                );
+            }
         }
         for l in &sims[0].vrm().links {
             turned = turned.max(
@@ -126,10 +148,18 @@ fn assert_lanes_match_in_every_mode(sk: &Skeleton, bones: &VrmSpringBones) {
 /// collider listed twice), two centres, per-joint parameters that differ from lane to
 /// lane, tails as joints and as offsets, and a spring that branches: spring "b" turns
 /// `b0`, `b1`, `b2`, `b3`, spring "y" turns `y2`, `y3`, which hang below `b1`; joints
-/// below spring joints that no spring turns (tails, an ornament with a child).
+/// below spring joints that no spring turns (tails, an ornament with a child); colliders
+/// on a joint whose parent nothing else reads (`head` below `neck`) and on the ornament
+/// below spring joints (fixed mode's step pose must hold their ancestors).
 fn every_part() -> (Skeleton, VrmSpringBones) {
     let mut b = SkeletonBuilder::new();
-    let root = b.add("root", None, Transform::IDENTITY);
+    // A root at -0 (the pose jobs compose it under the identity, which gives +0; a
+    // path that took the root's local as its model would show).
+    let root = b.add(
+        "root",
+        None,
+        Transform::from_translation(Vec3::new(-0.0, 0.0, -0.0)),
+    );
     let body = b.add("body", Some(root), Transform::from_translation(Vec3::Y));
     let lengths = [1usize, 2, 3, 4, 5, 6, 3, 3, 2, 4, 5, 6, 2, 4];
     let mut chains = Vec::new();
@@ -147,10 +177,16 @@ fn every_part() -> (Skeleton, VrmSpringBones) {
         );
         let mut joints = vec![p];
         for k in 1..len {
+            // One spring joint scaled (the step pose must carry the links' scales).
+            let scale = if (c, k) == (4, 2) {
+                Vec3::new(1.0, 1.2, 0.9)
+            } else {
+                Vec3::ONE
+            };
             p = b.add(
                 format!("h{c}_{k}"),
                 Some(p),
-                Transform::from_translation(dir * 0.06),
+                Transform::new(dir * 0.06, Quat::IDENTITY, scale),
             );
             joints.push(p);
             if c == 5 && k == 2 {
@@ -192,7 +228,18 @@ fn every_part() -> (Skeleton, VrmSpringBones) {
         Transform::from_translation(Vec3::new(0.03, -0.05, 0.0)),
     );
     let y3 = b.add("y3", Some(y2), step);
+    let neck = b.add(
+        "neck",
+        Some(body),
+        Transform::new(Vec3::Y * 0.1, Quat::from_rotation_z(0.2), Vec3::ONE),
+    );
+    let head = b.add(
+        "head",
+        Some(neck),
+        Transform::from_translation(Vec3::Y * 0.1),
+    );
     let (sk, _) = b.build().unwrap();
+    let ornament = sk.find("ornament").unwrap();
 
     let mut bones = VrmSpringBones::default();
     let shapes = [
@@ -226,13 +273,29 @@ fn every_part() -> (Skeleton, VrmSpringBones) {
     for shape in shapes {
         bones.colliders.push(VrmCollider { joint: body, shape });
     }
+    bones.colliders.push(VrmCollider {
+        joint: head,
+        shape: VrmShape::Sphere {
+            offset: Vec3::new(0.0, -0.2, 0.05),
+            radius: 0.06,
+            inside: false,
+        },
+    });
+    bones.colliders.push(VrmCollider {
+        joint: ornament,
+        shape: VrmShape::Sphere {
+            offset: Vec3::ZERO,
+            radius: 0.03,
+            inside: false,
+        },
+    });
     bones.collider_groups.push(VrmColliderGroup {
         name: "a".into(),
         colliders: vec![0, 1, 0],
     });
     bones.collider_groups.push(VrmColliderGroup {
         name: "b".into(),
-        colliders: vec![2, 3, 4],
+        colliders: vec![2, 3, 4, 5, 6],
     });
     let spring = |name: String, joints: &[usize], groups: Vec<usize>, center, seed: usize| {
         let joints = joints

@@ -943,13 +943,13 @@ impl F {
 /// constants as glam writes them.
 #[allow(clippy::approx_constant)]
 #[inline(always)]
-fn acos_approx(v: F) -> F {
-    let nonnegative = F::splat(0.0).le(v);
+fn acos_approx<T: Lane>(v: T) -> T {
+    let nonnegative = T::splat(0.0).le(v);
     let x = v.abs();
-    let omx = F::splat(1.0) - x;
-    let omx = F::select(omx.lt(F::splat(0.0)), F::splat(0.0), omx);
+    let omx = T::splat(1.0) - x;
+    let omx = T::select(omx.lt(T::splat(0.0)), T::splat(0.0), omx);
     let root = omx.sqrt();
-    let c = F::splat;
+    let c = T::splat;
     let r = c(-0.001_262_491_1) * x + c(0.006_670_09);
     let r = r * x - c(0.017_088_126);
     let r = r * x + c(0.030_891_88);
@@ -958,36 +958,31 @@ fn acos_approx(v: F) -> F {
     let r = r * x - c(0.214_598_8);
     let result = r * x + c(1.570_796_3);
     let result = result * root;
-    F::select(nonnegative, result, c(std::f32::consts::PI) - result)
+    T::select(nonnegative, result, c(std::f32::consts::PI) - result)
 }
 
 /// glam's SSE2 `m128_sin` (DirectXMath's 11th-degree minimax after reduction to
 /// [-π, π] and reflection into [-π/2, π/2]), per lane.
+///
+/// glam takes the sign of `x` by its bits where this compares with zero: they differ
+/// only for -0 and NaN. Rounding -0 with either sign of 2²³ gives +0; a NaN rounds to
+/// itself either way; and the reflection never takes π's sign for -0 (|-0| ≤ π/2) and
+/// gives the NaN for a NaN (`π − NaN`).
 #[inline(always)]
-fn sin_approx(v: F) -> F {
-    let c = F::splat;
+fn sin_approx<T: Lane>(v: T) -> T {
+    let c = T::splat;
+    let negative = |x: T| x.lt(c(0.0));
     // m128_mod_angles: v − 2π·round(v / 2π), rounding by the 2^23 trick.
     let q = v * c(0.159_154_94);
-    let mut rounded = [0.0f32; LANES];
-    for i in 0..LANES {
-        let x = q.0[i];
-        let magic = f32::from_bits(8_388_608f32.to_bits() | (x.to_bits() & 0x8000_0000));
-        let r1 = (x + magic) - magic;
-        rounded[i] = if x.abs() <= 8_388_608.0 { r1 } else { x };
-    }
-    let x = v - c(std::f32::consts::TAU) * F(rounded);
-    let mut y = [0.0f32; LANES];
-    for i in 0..LANES {
-        let xi = x.0[i];
-        let sign = xi.to_bits() & 0x8000_0000;
-        let pi = f32::from_bits(std::f32::consts::PI.to_bits() | sign);
-        y[i] = if f32::from_bits(xi.to_bits() & 0x7fff_ffff) <= std::f32::consts::FRAC_PI_2 {
-            xi
-        } else {
-            pi - xi
-        };
-    }
-    let x = F(y);
+    let magic = T::select(negative(q), c(-8_388_608.0), c(8_388_608.0));
+    let rounded = T::select(q.abs().le(c(8_388_608.0)), (q + magic) - magic, q);
+    let x = v - c(std::f32::consts::TAU) * rounded;
+    let pi = T::select(
+        negative(x),
+        c(-std::f32::consts::PI),
+        c(std::f32::consts::PI),
+    );
+    let x = T::select(x.abs().le(c(std::f32::consts::FRAC_PI_2)), x, pi - x);
     let x2 = x * x;
     let r = c(-2.388_985_9e-8) * x2 + c(2.752_556_2e-6);
     let r = r * x2 + c(-0.000_198_408_74);
@@ -997,10 +992,10 @@ fn sin_approx(v: F) -> F {
     r * x
 }
 
-impl Q {
+impl<T: Lane> Q<T> {
     /// Scaled per lane.
     #[inline(always)]
-    fn scale(self, s: F) -> Q {
+    fn scale(self, s: T) -> Q<T> {
         Q {
             x: self.x * s,
             y: self.y * s,
@@ -1010,7 +1005,7 @@ impl Q {
     }
 
     #[inline(always)]
-    fn add(self, o: Q) -> Q {
+    fn add(self, o: Q<T>) -> Q<T> {
         Q {
             x: self.x + o.x,
             y: self.y + o.y,
@@ -1020,7 +1015,7 @@ impl Q {
     }
 
     #[inline(always)]
-    fn neg(self) -> Q {
+    fn neg(self) -> Q<T> {
         Q {
             x: -self.x,
             y: -self.y,
@@ -1031,13 +1026,13 @@ impl Q {
 
     /// glam's SSE2 `Quat::slerp`, per lane.
     #[inline(always)]
-    pub fn slerp(self, end: Q, s: F) -> Q {
+    pub fn slerp(self, end: Q<T>, s: T) -> Q<T> {
         let dot = self.dot(end);
-        let flip = dot.lt(F::splat(0.0));
+        let flip = dot.lt(T::splat(0.0));
         let end = Q::select(flip, end.neg(), end);
-        let dot = F::select(flip, -dot, dot);
-        let one = F::splat(1.0);
-        let near = dot.gt(F::splat(1.0 - f32::EPSILON));
+        let dot = T::select(flip, -dot, dot);
+        let one = T::splat(1.0);
+        let near = dot.gt(T::splat(1.0 - f32::EPSILON));
         let lerped = self.scale(one - s).add(end.scale(s)).normalize();
         let theta = acos_approx(dot);
         let scale1 = sin_approx(theta * (one - s));
@@ -1055,8 +1050,8 @@ impl Q {
 
     /// [`crate::math::slerp_shortest`] per lane.
     #[inline(always)]
-    pub fn slerp_shortest(self, b: Q, t: F) -> Q {
-        let b = Q::select(self.dot(b).lt(F::splat(0.0)), b.neg(), b);
+    pub fn slerp_shortest(self, b: Q<T>, t: T) -> Q<T> {
+        let b = Q::select(self.dot(b).lt(T::splat(0.0)), b.neg(), b);
         self.slerp(b, t).normalize()
     }
 }
@@ -1084,13 +1079,13 @@ impl<T: Lane> V3<T> {
     }
 }
 
-/// `out[k] = a[k].lerp(&b[k], t)` for every `k` ([`Transform::lerp`]'s bits), eight
-/// transforms at a time, compiled for AVX2 where `avx2` allows it and the CPU has it. The
-/// slices have the same length.
-pub(crate) fn lerp_transforms(
+/// `out[k] = a[k].lerp(&b[k], t)` for every `k` in `joints` ([`Transform::lerp`]'s bits),
+/// eight at a time, compiled for AVX2 where `avx2` allows it and the CPU has it.
+pub(crate) fn lerp_transforms_at(
     a: &[Transform],
     b: &[Transform],
     t: f32,
+    joints: &[usize],
     out: &mut [Transform],
     avx2: bool,
 ) {
@@ -1099,46 +1094,56 @@ pub(crate) fn lerp_transforms(
         // SAFETY: the function only requires AVX2, which the CPU was just found to have.
         #[allow(unsafe_code)]
         unsafe {
-            return lerp_transforms_avx2(a, b, t, out);
+            return lerp_transforms_at_avx2(a, b, t, joints, out);
         }
     }
     let _ = avx2;
-    lerp_transforms_lanes(a, b, t, out)
+    lerp_transforms_at_lanes::<F>(a, b, t, joints, out)
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-fn lerp_transforms_avx2(a: &[Transform], b: &[Transform], t: f32, out: &mut [Transform]) {
-    lerp_transforms_lanes(a, b, t, out)
+fn lerp_transforms_at_avx2(
+    a: &[Transform],
+    b: &[Transform],
+    t: f32,
+    joints: &[usize],
+    out: &mut [Transform],
+) {
+    // The explicit AVX lane type only inside this function, after the CPU was found to
+    // have AVX2 (the condition of its soundness, `crowd/avx.rs`).
+    lerp_transforms_at_lanes::<super::avx::Fa>(a, b, t, joints, out)
 }
 
 #[inline(always)]
-fn lerp_transforms_lanes(a: &[Transform], b: &[Transform], t: f32, out: &mut [Transform]) {
-    let t = F::splat(t);
-    for ((a, b), out) in a
-        .chunks(LANES)
-        .zip(b.chunks(LANES))
-        .zip(out.chunks_mut(LANES))
-    {
+fn lerp_transforms_at_lanes<T: Lane>(
+    a: &[Transform],
+    b: &[Transform],
+    t: f32,
+    joints: &[usize],
+    out: &mut [Transform],
+) {
+    let t = T::splat(t);
+    for chunk in joints.chunks(LANES) {
         let (mut la, mut lb) = (
             Trs::splat(&Transform::IDENTITY),
             Trs::splat(&Transform::IDENTITY),
         );
-        for (l, (x, y)) in a.iter().zip(b).enumerate() {
-            la.set(l, x);
-            lb.set(l, y);
+        for (l, &j) in chunk.iter().enumerate() {
+            la.set(l, &a[j]);
+            lb.set(l, &b[j]);
         }
-        let r = la.lerp(&lb, t);
-        for (l, o) in out.iter_mut().enumerate() {
-            *o = r.get(l);
+        let r = Trs::<T>::of(&la).lerp(&Trs::of(&lb), t).f();
+        for (l, &j) in chunk.iter().enumerate() {
+            out[j] = r.get(l);
         }
     }
 }
 
-impl Trs {
+impl<T: Lane> Trs<T> {
     /// [`Transform::lerp`] per lane.
     #[inline(always)]
-    pub fn lerp(&self, other: &Trs, t: F) -> Trs {
+    pub fn lerp(&self, other: &Trs<T>, t: T) -> Trs<T> {
         Trs {
             t: self.t.lerp(other.t, t),
             r: self.r.slerp_shortest(other.r, t),

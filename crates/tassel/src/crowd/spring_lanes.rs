@@ -37,6 +37,19 @@ pub(crate) struct SpringLanes {
     /// Joints below a link that are not links, in skeleton order: the update leaves their
     /// models stale.
     below: Vec<usize>,
+    /// Fixed mode's step pose: the joints whose step model the update or the colliders
+    /// read before the update writes it (colliders' and centres' joints, the parents of
+    /// the groups' first rows that are not links, and everything above them), in
+    /// skeleton order.
+    step_read: Vec<usize>,
+    /// The links outside `step_read`: the update reads only their local translation and
+    /// scale (it writes their rotation and model before anything reads them).
+    step_links: Vec<usize>,
+    /// The joints whose models the job reads from the models it is given, when no node
+    /// constraint runs first: those no spring moves, and `step_read` (a collider or a
+    /// centre may hang below a link), in skeleton order. Every other model the job
+    /// writes before it reads it.
+    input: Vec<usize>,
 }
 
 /// Up to [`LANES`] columns with the same colliders and centre.
@@ -93,6 +106,8 @@ pub(crate) struct SpringIo<'a> {
     pub(crate) length: &'a [f32],
     pub(crate) stale_tail: &'a [Vec3],
     pub(crate) rotation: &'a mut [Quat],
+    /// The step before's rotations (fixed mode's output lies between them and `rotation`).
+    pub(crate) rotation_before: &'a [Quat],
 }
 
 impl SpringIo<'_> {
@@ -204,7 +219,84 @@ impl SpringLanes {
         let below = (0..n)
             .filter(|&j| affected[j] && link_at[j].is_none())
             .collect();
-        Some(SpringLanes { groups, below })
+        // What a step reads of its interpolated pose before the update writes it.
+        let mut read = vec![false; n];
+        for &(j, _) in &rig.colliders {
+            read[j] = true;
+        }
+        for l in links {
+            if let Some(c) = l.center {
+                read[c] = true;
+            }
+            if let Some(p) = l.parent.filter(|&p| link_at[p].is_none()) {
+                read[p] = true;
+            }
+        }
+        for j in (0..n).rev() {
+            if let (true, Some(p)) = (read[j], sk.parent(j)) {
+                read[p] = true;
+            }
+        }
+        let step_read = (0..n).filter(|&j| read[j]).collect();
+        let input = (0..n).filter(|&j| read[j] || !affected[j]).collect();
+        let step_links = links
+            .iter()
+            .map(|l| l.joint)
+            .filter(|&j| !read[j])
+            .collect();
+        Some(SpringLanes {
+            groups,
+            below,
+            step_read,
+            step_links,
+            input,
+        })
+    }
+
+    /// The models of [`SpringLanes`]' input joints from `locals`, as
+    /// [`crate::pose::LocalToModelJob`] composes them (a root under the identity): all the
+    /// lane path reads of the models it is given. The others are left as they were.
+    pub(crate) fn compose_input(
+        &self,
+        sk: &Skeleton,
+        locals: &[Transform],
+        models: &mut [Transform],
+    ) {
+        for &j in &self.input {
+            models[j] = match sk.parent(j) {
+                Some(p) => models[p] * locals[j],
+                None => Transform::IDENTITY * locals[j],
+            };
+        }
+    }
+
+    /// Fixed mode's step pose at `w` between last frame's locals `prev` and this frame's
+    /// `now`, as far as a step reads it: `step_locals` and `step_models` as the whole
+    /// pose's lerp and refresh give them (a root taking its local as its model) for the
+    /// joints the step reads, and the links' local translations and scales; the rest is
+    /// left as it was (the update writes the links' rotations and models before reading
+    /// them, and nothing in a step reads the joints below the links).
+    pub(crate) fn step_pose(
+        &self,
+        sk: &Skeleton,
+        (prev, now): (&[Transform], &[Transform]),
+        w: f32,
+        step_locals: &mut [Transform],
+        step_models: &mut [Transform],
+        avx2: bool,
+    ) {
+        super::lanes::lerp_transforms_at(prev, now, w, &self.step_read, step_locals, avx2);
+        for &j in &self.step_read {
+            step_models[j] = match sk.parent(j) {
+                Some(p) => step_models[p] * step_locals[j],
+                None => step_locals[j],
+            };
+        }
+        for &j in &self.step_links {
+            // `Transform::lerp`'s translation and scale.
+            step_locals[j].translation = prev[j].translation.lerp(now[j].translation, w);
+            step_locals[j].scale = prev[j].scale.lerp(now[j].scale, w);
+        }
     }
 
     /// After an update: the models of the joints below the links, from their parents'
@@ -248,16 +340,19 @@ impl SpringLanes {
         self.update_baseline(rig, io)
     }
 
-    /// The fixed mode's output pass (`collide_output` in `dynamics/vrm/job.rs`): each
-    /// link's tail, from the output pose in `io.locals`, pushed out of the colliders and
-    /// settled, the joint turned where a collider acted; then every model below a link
-    /// recomputed. Reads `io.component`, `io.placed` and `io.length`; writes the links'
-    /// local rotations and the models.
+    /// The fixed mode's output rotations and pass (`run` and `collide_output` in
+    /// `dynamics/vrm/job.rs`): each link's local rotation `w` of the way from the step
+    /// before's to the last step's (`slerp_shortest`; the last step's from `w` = 1 on);
+    /// each link's tail from that pose pushed out of the colliders and settled, the joint
+    /// turned where a collider acted; then every model below a link recomputed. Reads
+    /// `io.component`, `io.placed`, `io.length` and the models of the joints above the
+    /// links; writes the links' local rotations and the models of the links and below.
     pub(crate) fn collide_output(
         &self,
         sk: &Skeleton,
         rig: &VrmRig,
         io: &mut SpringIo<'_>,
+        w: f32,
         avx2: bool,
     ) {
         #[cfg(target_arch = "x86_64")]
@@ -265,37 +360,53 @@ impl SpringLanes {
             // SAFETY: as in `update`.
             #[allow(unsafe_code)]
             unsafe {
-                self.output_avx2(rig, io);
+                self.output_avx2(rig, io, w);
             }
             self.refresh_below(sk, io.locals, io.models);
             return;
         }
         let _ = avx2;
-        self.output_baseline(rig, io);
+        self.output_baseline(rig, io, w);
         self.refresh_below(sk, io.locals, io.models);
     }
 
     #[inline(never)]
-    fn output_baseline(&self, rig: &VrmRig, io: &mut SpringIo<'_>) {
-        self.output_lanes::<F>(rig, io)
+    fn output_baseline(&self, rig: &VrmRig, io: &mut SpringIo<'_>, w: f32) {
+        self.output_lanes::<F>(rig, io, w)
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
     #[inline(never)]
-    fn output_avx2(&self, rig: &VrmRig, io: &mut SpringIo<'_>) {
-        self.output_lanes::<Fa>(rig, io)
+    fn output_avx2(&self, rig: &VrmRig, io: &mut SpringIo<'_>, w: f32) {
+        self.output_lanes::<Fa>(rig, io, w)
     }
 
     #[inline(always)]
-    fn output_lanes<T: Lane>(&self, rig: &VrmRig, io: &mut SpringIo<'_>) {
+    fn output_lanes<T: Lane>(&self, rig: &VrmRig, io: &mut SpringIo<'_>, w: f32) {
         let comp = Trs::<T>::of(&Trs::splat(&io.component));
         io.place_in_lanes();
         for g in &self.groups {
             let colliders = &rig.link_colliders[g.colliders.clone()];
             let mut above = Trs::<T>::of(&Trs::splat(&Transform::IDENTITY));
             for (d, row) in g.rows.iter().enumerate() {
-                let (parent, local) = io.row_pose(row, d, above);
+                let (parent, mut local) = io.row_pose(row, d, above);
+                // The output rotation, between the last two steps'.
+                let (mut before, mut last) = (Q::splat(Quat::IDENTITY), Q::splat(Quat::IDENTITY));
+                for l in 0..LANES {
+                    let i = row.link[l];
+                    before.set(l, io.rotation_before[i]);
+                    last.set(l, io.rotation[i]);
+                }
+                local.r = if w >= 1.0 {
+                    Q::of(last)
+                } else {
+                    Q::<T>::of(before).slerp_shortest(Q::of(last), T::splat(w))
+                };
+                let between = local.r.f();
+                for l in 0..row.n {
+                    io.locals[row.joint[l]].rotation = between.get(l);
+                }
                 // The joint's model from the output rotation (the scalar refresh's).
                 let own = parent.mul(&local);
                 let mut model = own;

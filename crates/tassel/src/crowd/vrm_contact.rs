@@ -211,7 +211,10 @@ pub(crate) fn collide_tail<T: Lane>(
             acted = acted.or(hit);
         }
     }
-    if exact {
+    // A lane where no collider acted kept its tail, at which every collider's distance
+    // was found not negative: no penetration to settle (the scalar settling's first pass
+    // changes nothing and stops). So with no lane acted, the settling is skipped.
+    if exact && acted.any() {
         let zero = T::splat(0.0);
         for _ in 0..2 {
             let mut changed = <T::M as Mask>::NONE;

@@ -142,6 +142,17 @@ impl VrmRig {
         self.lanes.as_ref().map_or(0, |l| l.groups())
     }
 
+    /// The lane plan when the job runs it (`simd` not [`crate::crowd::SimdUse::Scalar`])
+    /// and no node constraint runs before it: then the job reads, of the models it is
+    /// given, only those of the plan's input joints (`SpringLanes::compose_input`).
+    pub(crate) fn lanes_for(
+        &self,
+        simd: crate::crowd::SimdUse,
+    ) -> Option<&crate::crowd::spring_lanes::SpringLanes> {
+        let runs = simd != crate::crowd::SimdUse::Scalar && self.constraints.list.is_empty();
+        self.lanes.as_ref().filter(|_| runs)
+    }
+
     /// True when nothing is simulated.
     pub fn is_empty(&self) -> bool {
         self.links.is_empty() && self.constraints.list.is_empty()

@@ -4,14 +4,12 @@
 use super::collide::PlacedVrmCollider;
 use super::compile::{VrmLink, VrmRig};
 use super::settings::VrmMode;
-use crate::crowd::lanes::lerp_transforms;
 use crate::crowd::spring_lanes::SpringIo;
 use crate::crowd::vrm_contact::Placed;
 use crate::crowd::SimdUse;
 use crate::dynamics::path::CharacterPath;
 use crate::error::{Error, Result};
 use crate::math::{normalize_or, rotation_arc, slerp_shortest, Transform};
-use crate::pose::LocalToModelJob;
 use crate::skeleton::Skeleton;
 use glam::{Quat, Vec3};
 
@@ -102,6 +100,7 @@ impl VrmState {
             length: &self.length,
             stale_tail: &self.stale_tail,
             rotation: &mut self.rotation,
+            rotation_before: &self.rotation_before,
         }
     }
 
@@ -232,6 +231,13 @@ impl VrmJob<'_> {
     /// Validates, then runs the frame. Never allocates.
     pub fn run(self) -> Result<()> {
         self.validate()?;
+        self.run_validated();
+        Ok(())
+    }
+
+    /// Runs the frame on inputs the caller has checked as [`VrmJob::validate`] does
+    /// ([`crate::CharacterSim`] checks its input before any job runs).
+    pub(crate) fn run_validated(self) {
         let VrmJob {
             skeleton,
             rig,
@@ -251,7 +257,7 @@ impl VrmJob<'_> {
                 // is the model pose as `LocalToModelJob` computes it.
                 crate::pose::local_to_model_into(skeleton, locals, models);
             }
-            return Ok(());
+            return;
         }
         state.path.push(component, dt);
         let opts = &rig.options;
@@ -264,8 +270,12 @@ impl VrmJob<'_> {
         // Whether the lane path updated every link's model (then only the joints below
         // the links need their models recomputed at the end).
         let mut lanes_ran = false;
+        // Whether `models` is still the model pose of the animated `locals` given (no
+        // reset wrote it with the lazy refresh's root rule).
+        let mut models_given = rig.constraints.list.is_empty();
         if state.needs_reset {
             reset(skeleton, rig, state, &component, locals, models);
+            models_given = false;
         } else {
             match opts.mode {
                 VrmMode::Spec | VrmMode::ThreeVrm => {
@@ -286,6 +296,7 @@ impl VrmJob<'_> {
         {
             reset(skeleton, rig, state, &component, locals, models);
             lanes_ran = false;
+            models_given = false;
         }
         state.prev_locals.copy_from_slice(locals);
         state.prev_component = component;
@@ -298,8 +309,14 @@ impl VrmJob<'_> {
             // This frame's colliders, from the animated pose.
             place_colliders(rig, state, &component, models);
         }
-        // (The lanes' slerp, eight links at a time, measured no faster than these.)
-        for (i, l) in rig.links.iter().enumerate() {
+        // Fixed mode's output pass in lanes: it turns the links to their output rotations
+        // (the same slerps, eight at a time) and composes every link's model from its
+        // parent's, then the joints below the links.
+        let lane_output = opts.mode == VrmMode::Fixed
+            && !rig.link_colliders.is_empty()
+            && state.simd != SimdUse::Scalar
+            && rig.lanes.is_some();
+        for (i, l) in rig.links.iter().enumerate().filter(|_| !lane_output) {
             locals[l.joint].rotation = if w >= 1.0 {
                 state.rotation[i]
             } else {
@@ -311,42 +328,41 @@ impl VrmJob<'_> {
             // composes them as this pass would), the joints no link moves keep the models
             // given: only the joints below the links are left.
             (Some(lanes), true) => lanes.refresh_below(skeleton, locals, models),
-            _ => LocalToModelJob {
-                skeleton,
-                root: Transform::IDENTITY,
-                locals,
-                models,
-            }
-            .run()?,
+            // With the models given elsewhere, the output pass leaves nothing to compose.
+            (Some(_), false) if lane_output && models_given => {}
+            _ => crate::pose::local_to_model_into(skeleton, locals, models),
         }
         if opts.mode == VrmMode::Fixed && !rig.link_colliders.is_empty() {
             // The interpolated pose lags a step and may cut through a collider between
             // two steps: it is pushed out by this frame's colliders like a step's tail.
-            collide_output(skeleton, rig, state, &component, locals, models);
+            collide_output(skeleton, rig, state, &component, w, locals, models);
         }
         if opts.mode == VrmMode::ThreeVrm {
             // Where each tail node ends this frame: next frame's bone length measures to it.
             record_tails(rig, state, &component, models);
         }
-        Ok(())
     }
 }
 
 /// Fixed-mode output pass: each link's tail (from the interpolated pose) pushed out of this
 /// frame's colliders with the spec's push and length projection, the rotation rewritten.
+/// The lane path also writes the links' output rotations (`w` of the way between the last
+/// two steps' rotations) first; the scalar path finds them written by the caller.
 fn collide_output(
     sk: &Skeleton,
     rig: &VrmRig,
     state: &mut VrmState,
     component: &Transform,
+    w: f32,
     locals: &mut [Transform],
     models: &mut [Transform],
 ) {
     if let (Some(lanes), true) = (&rig.lanes, state.simd != SimdUse::Scalar) {
-        // The same results, several springs at a time (`crowd/spring_lanes.rs`).
+        // The same results, several springs at a time (`crowd/spring_lanes.rs`), which
+        // also turn the links to their output rotations (`w`).
         let avx2 = state.simd == SimdUse::Auto;
         let mut io = state.lane_io(component, 0.0, VrmMode::Fixed, locals, models);
-        lanes.collide_output(sk, rig, &mut io, avx2);
+        lanes.collide_output(sk, rig, &mut io, w, avx2);
         return;
     }
     let mut stale_from = sk.len();
@@ -644,23 +660,27 @@ fn run_fixed(sk: &Skeleton, rig: &VrmRig, state: &mut VrmState, dt: f32, locals:
         } else {
             1.0
         };
-        if state.simd == SimdUse::Scalar {
-            for (s, (a, b)) in state
-                .step_locals
-                .iter_mut()
-                .zip(state.prev_locals.iter().zip(locals))
-            {
-                *s = a.lerp(b, w);
-            }
-        } else {
-            // The same lerps, eight joints at a time.
-            let avx2 = state.simd == SimdUse::Auto;
-            lerp_transforms(&state.prev_locals, locals, w, &mut state.step_locals, avx2);
-        }
         let comp = state.path.at(w);
         let mut step_locals = std::mem::take(&mut state.step_locals);
         let mut step_models = std::mem::take(&mut state.step_models);
-        refresh(sk, &step_locals, &mut step_models, 0, sk.len() - 1);
+        match (&rig.lanes, state.simd) {
+            (Some(lanes), simd) if simd != SimdUse::Scalar => {
+                // Only what the lane update and the colliders read of the step's pose (the
+                // same values where they read it).
+                let avx2 = simd == SimdUse::Auto;
+                let frames = (&state.prev_locals[..], locals);
+                lanes.step_pose(sk, frames, w, &mut step_locals, &mut step_models, avx2);
+            }
+            _ => {
+                for (s, (a, b)) in step_locals
+                    .iter_mut()
+                    .zip(state.prev_locals.iter().zip(locals))
+                {
+                    *s = a.lerp(b, w);
+                }
+                refresh(sk, &step_locals, &mut step_models, 0, sk.len() - 1);
+            }
+        }
         place_colliders(rig, state, &comp, &step_models);
         state.rotation_before.copy_from_slice(&state.rotation);
         update(
