@@ -4,14 +4,15 @@
 use crate::math::Transform;
 use crate::skeleton::Skeleton;
 use std::ops::Deref;
-use std::sync::{Mutex, MutexGuard, PoisonError};
+use std::sync::{PoisonError, RwLock, RwLockReadGuard};
 
 /// The last frame's animated model pose: complete, or the animated locals to compose it
 /// from on first use. Behind a lock so that [`AnimatedPose::models`] can finish it through
 /// a shared reference (the character stays `Send + Sync`); the frame itself writes through
-/// `&mut` and never locks.
+/// `&mut` and never locks. A read lock: any number of [`AnimatedModels`] may be held at
+/// once (the pose is complete before the first is handed out, so no writer waits).
 #[derive(Debug, Default)]
-pub(crate) struct AnimatedPose(Mutex<Inner>);
+pub(crate) struct AnimatedPose(RwLock<Inner>);
 
 #[derive(Debug, Default, Clone)]
 struct Inner {
@@ -22,7 +23,7 @@ struct Inner {
 
 impl AnimatedPose {
     pub(crate) fn new(models: &[Transform]) -> AnimatedPose {
-        AnimatedPose(Mutex::new(Inner {
+        AnimatedPose(RwLock::new(Inner {
             locals: vec![Transform::IDENTITY; models.len()],
             models: models.to_vec(),
             complete: true,
@@ -49,20 +50,28 @@ impl AnimatedPose {
 
     /// The animated model pose (composed now if the frame left it to be).
     pub(crate) fn models(&self, sk: &Skeleton) -> AnimatedModels<'_> {
-        let mut inner = self.0.lock().unwrap_or_else(PoisonError::into_inner);
-        if !inner.complete {
-            let Inner { locals, models, .. } = &mut *inner;
-            crate::pose::local_to_model_into(sk, locals, models);
-            inner.complete = true;
+        {
+            let read = self.0.read().unwrap_or_else(PoisonError::into_inner);
+            if read.complete {
+                return AnimatedModels(read);
+            }
         }
-        AnimatedModels(inner)
+        {
+            let mut write = self.0.write().unwrap_or_else(PoisonError::into_inner);
+            if !write.complete {
+                let Inner { locals, models, .. } = &mut *write;
+                crate::pose::local_to_model_into(sk, locals, models);
+                write.complete = true;
+            }
+        }
+        AnimatedModels(self.0.read().unwrap_or_else(PoisonError::into_inner))
     }
 }
 
 impl Clone for AnimatedPose {
     fn clone(&self) -> AnimatedPose {
-        let inner = self.0.lock().unwrap_or_else(PoisonError::into_inner);
-        AnimatedPose(Mutex::new(inner.clone()))
+        let inner = self.0.read().unwrap_or_else(PoisonError::into_inner);
+        AnimatedPose(RwLock::new(inner.clone()))
     }
 }
 
@@ -70,7 +79,7 @@ impl Clone for AnimatedPose {
 /// (`Deref<Target = [Transform]>`), borrowed from the character
 /// ([`crate::CharacterSim::animated_models`]).
 #[derive(Debug)]
-pub struct AnimatedModels<'a>(MutexGuard<'a, Inner>);
+pub struct AnimatedModels<'a>(RwLockReadGuard<'a, Inner>);
 
 impl Deref for AnimatedModels<'_> {
     type Target = [Transform];

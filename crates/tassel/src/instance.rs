@@ -342,7 +342,7 @@ impl CharacterSim {
     /// The last animated (input) model pose: a slice of model transforms
     /// (`animated_models()[joint]`, `.iter()`). Composed on first use after a frame whose
     /// solvers did not need it whole (VRM springs in lanes compose their joints
-    /// themselves); release it before the next [`frame`](Self::frame).
+    /// themselves); several may be held at once.
     pub fn animated_models(&self) -> AnimatedModels<'_> {
         self.animated.models(&self.rig.skeleton)
     }

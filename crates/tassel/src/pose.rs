@@ -53,8 +53,22 @@ pub(crate) fn compose_by_depth(
     locals: &[Transform],
     models: &mut [Transform],
 ) {
-    for &i in sk.level_order() {
-        let i = usize::from(i);
+    let order = sk.level_order().iter().map(|&i| usize::from(i));
+    compose_joints(sk, order, root, locals, models);
+}
+
+/// The model transforms of the `joints` listed (each after its parent when both are
+/// listed; a parent not listed keeps the model it has), with [`compose_by_depth`]'s root
+/// rule. The others are left as they are.
+#[inline]
+pub(crate) fn compose_joints(
+    sk: &Skeleton,
+    joints: impl IntoIterator<Item = usize>,
+    root: Option<&Transform>,
+    locals: &[Transform],
+    models: &mut [Transform],
+) {
+    for i in joints {
         models[i] = match (sk.parent(i), root) {
             (Some(p), _) => models[p] * locals[i],
             (None, Some(root)) => *root * locals[i],

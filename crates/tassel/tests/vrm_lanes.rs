@@ -103,6 +103,8 @@ fn assert_lanes_match(
         }
         for (w, sim) in ways.iter().zip(&sims) {
             let got = sim.animated_models();
+            // A second view while the first is held (a shared read, never a deadlock).
+            assert_eq!(sim.animated_models().len(), got.len());
             for j in 0..sk.len() {
                 assert_eq!(
                     bits(&got[j]),

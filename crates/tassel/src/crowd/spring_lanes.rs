@@ -26,6 +26,7 @@ use super::lanes::{rotation_arc_from_lanes, Lane, Mask, Trs, F, LANES, M, Q, V3}
 use super::vrm_contact::{collide_tail, Placed};
 use crate::dynamics::vrm::{PlacedVrmCollider, VrmMode, VrmRig};
 use crate::math::{normalize_or, Transform};
+use crate::pose::compose_joints;
 use crate::skeleton::Skeleton;
 use glam::{Quat, Vec3};
 use std::ops::Range;
@@ -262,12 +263,8 @@ impl SpringLanes {
         locals: &[Transform],
         models: &mut [Transform],
     ) {
-        for &j in &self.input {
-            models[j] = match sk.parent(j) {
-                Some(p) => models[p] * locals[j],
-                None => Transform::IDENTITY * locals[j],
-            };
-        }
+        let input = self.input.iter().copied();
+        compose_joints(sk, input, Some(&Transform::IDENTITY), locals, models);
     }
 
     /// Fixed mode's step pose at `w` between last frame's locals `prev` and this frame's
@@ -286,12 +283,8 @@ impl SpringLanes {
         avx2: bool,
     ) {
         super::lanes::lerp_transforms_at(prev, now, w, &self.step_read, step_locals, avx2);
-        for &j in &self.step_read {
-            step_models[j] = match sk.parent(j) {
-                Some(p) => step_models[p] * step_locals[j],
-                None => step_locals[j],
-            };
-        }
+        let read = self.step_read.iter().copied();
+        compose_joints(sk, read, None, step_locals, step_models);
         for &j in &self.step_links {
             // `Transform::lerp`'s translation and scale.
             step_locals[j].translation = prev[j].translation.lerp(now[j].translation, w);
@@ -310,11 +303,8 @@ impl SpringLanes {
         locals: &[Transform],
         models: &mut [Transform],
     ) {
-        for &k in &self.below {
-            if let Some(p) = sk.parent(k) {
-                models[k] = models[p] * locals[k];
-            }
-        }
+        // (Every joint below a link has a parent: the root rule never applies.)
+        compose_joints(sk, self.below.iter().copied(), None, locals, models);
     }
 
     /// How many lane groups the update runs.
