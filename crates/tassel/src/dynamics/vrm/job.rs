@@ -4,7 +4,7 @@
 use super::collide::PlacedVrmCollider;
 use super::compile::{VrmLink, VrmRig};
 use super::settings::VrmMode;
-use crate::crowd::spring_lanes::SpringIo;
+use crate::crowd::spring_lanes::{SpringIo, SpringLanes};
 use crate::crowd::vrm_contact::Placed;
 use crate::crowd::SimdUse;
 use crate::dynamics::path::CharacterPath;
@@ -314,8 +314,7 @@ impl VrmJob<'_> {
         // parent's, then the joints below the links.
         let lane_output = opts.mode == VrmMode::Fixed
             && !rig.link_colliders.is_empty()
-            && state.simd != SimdUse::Scalar
-            && rig.lanes.is_some();
+            && lane_plan(rig, state).is_some();
         for (i, l) in rig.links.iter().enumerate().filter(|_| !lane_output) {
             locals[l.joint].rotation = if w >= 1.0 {
                 state.rotation[i]
@@ -344,6 +343,12 @@ impl VrmJob<'_> {
     }
 }
 
+/// The lane plan when this state runs it (the rig allows it and `SimdUse` is not
+/// `Scalar`): the one condition of every lane path of the job.
+fn lane_plan<'a>(rig: &'a VrmRig, state: &VrmState) -> Option<&'a SpringLanes> {
+    rig.lanes.as_ref().filter(|_| state.simd != SimdUse::Scalar)
+}
+
 /// Fixed-mode output pass: each link's tail (from the interpolated pose) pushed out of this
 /// frame's colliders with the spec's push and length projection, the rotation rewritten.
 /// The lane path also writes the links' output rotations (`w` of the way between the last
@@ -357,7 +362,7 @@ fn collide_output(
     locals: &mut [Transform],
     models: &mut [Transform],
 ) {
-    if let (Some(lanes), true) = (&rig.lanes, state.simd != SimdUse::Scalar) {
+    if let Some(lanes) = lane_plan(rig, state) {
         // The same results, several springs at a time (`crowd/spring_lanes.rs`), which
         // also turn the links to their output rotations (`w`).
         let avx2 = state.simd == SimdUse::Auto;
@@ -471,7 +476,7 @@ fn update(
     locals: &mut [Transform],
     models: &mut [Transform],
 ) -> bool {
-    if let (Some(lanes), true) = (&rig.lanes, state.simd != SimdUse::Scalar) {
+    if let Some(lanes) = lane_plan(rig, state) {
         // The same results, several springs at a time (`crowd/spring_lanes.rs`); the
         // models of joints that are not links are left stale: every caller recomputes
         // the whole model pose before reading them.
@@ -663,15 +668,15 @@ fn run_fixed(sk: &Skeleton, rig: &VrmRig, state: &mut VrmState, dt: f32, locals:
         let comp = state.path.at(w);
         let mut step_locals = std::mem::take(&mut state.step_locals);
         let mut step_models = std::mem::take(&mut state.step_models);
-        match (&rig.lanes, state.simd) {
-            (Some(lanes), simd) if simd != SimdUse::Scalar => {
+        match lane_plan(rig, state) {
+            Some(lanes) => {
                 // Only what the lane update and the colliders read of the step's pose (the
                 // same values where they read it).
-                let avx2 = simd == SimdUse::Auto;
+                let avx2 = state.simd == SimdUse::Auto;
                 let frames = (&state.prev_locals[..], locals);
                 lanes.step_pose(sk, frames, w, &mut step_locals, &mut step_models, avx2);
             }
-            _ => {
+            None => {
                 for (s, (a, b)) in step_locals
                     .iter_mut()
                     .zip(state.prev_locals.iter().zip(locals))
