@@ -537,3 +537,72 @@ fn classic_gravity_steps_are_kawaiiphysics_three_versions() {
     .unwrap();
     assert_eq!(rig.chains[0].classic_gravity, ClassicGravity::HalfDtSquared);
 }
+
+/// A chain that starts again (a teleport past its threshold) leaves the other chains of
+/// the character alone: a chain that does not reset gives the same bits with a resetting
+/// chain before it in the rig as on its own, through a jump in the middle of a motion
+/// whose colliders move (the steps of the jump frame interpolate the colliders between
+/// last frame's placement and this one's, whatever another chain does).
+#[test]
+fn a_chain_reset_does_not_change_the_other_chains() {
+    let (sk, mut rig) = tassel::builtin::bench_character(2, 6, 4);
+    for ch in &mut rig.chains {
+        ch.stiffness = 0.1;
+        ch.target_framerate = 90.0; // steps between frames: colliders interpolated
+    }
+    rig.chains[0].teleport_distance = 0.5;
+    rig.chains[1].teleport_distance = 0.0;
+    rig.chains[1].teleport_rotation = 0.0;
+    let alone = RigSettings {
+        chains: vec![rig.chains[1].clone()],
+        ..rig.clone()
+    };
+    let run = |rig: &RigSettings| -> Vec<[u32; 3]> {
+        let chains = ChainRig::new(&sk, rig).unwrap();
+        let mut state = ChainState::new(&chains);
+        let last = chains.chain_points(chains.chain_count() - 1);
+        let mut out = Vec::new();
+        let mut resets = 0;
+        for f in 0..120 {
+            let t = f as f32 / 60.0;
+            let mut locals = sk.rest().to_vec();
+            // The root swings: the colliders (on the root) move in model space.
+            locals[0].rotation = Quat::from_rotation_z(0.6 * (4.0 * t).sin());
+            let mut models = locals.clone();
+            tassel::LocalToModelJob {
+                skeleton: &sk,
+                root: Transform::IDENTITY,
+                locals: &locals,
+                models: &mut models,
+            }
+            .run()
+            .unwrap();
+            let jump = if f >= 60 { 3.0 } else { 0.0 };
+            let before = state.teleport_count();
+            ChainJob {
+                skeleton: &sk,
+                rig: &chains,
+                state: &mut state,
+                component: Transform::from_translation(Vec3::new(jump, 0.0, 0.1 * t)),
+                dt: 1.0 / 60.0,
+                locals: &mut locals,
+                models: &mut models,
+                level: None,
+            }
+            .run()
+            .unwrap();
+            resets += state.teleport_count() - before;
+            for p in last.clone() {
+                out.push(state.output_positions()[p].to_array().map(f32::to_bits));
+            }
+        }
+        if rig.chains.len() == 2 {
+            assert_eq!(resets, 1, "the first chain resets once, on the jump");
+        }
+        out
+    };
+    let (with, without) = (run(&rig), run(&alone));
+    assert_eq!(with.len(), without.len());
+    let first = with.iter().zip(&without).position(|(a, b)| a != b);
+    assert_eq!(first, None, "first differing point (frame × 6 + point)");
+}

@@ -210,9 +210,9 @@ fn chain_crowd_gives_the_single_character_bits_with_every_feature() {
                 };
             }
             _ => {
-                // Never resets on a jump, beside chains that do: the chains after a reset
-                // in the same frame step between the colliders as the reset left them
-                // (at 90 Hz: steps between frames, where that shows).
+                // Never resets on a jump, beside chains that do: it steps between last
+                // frame's colliders and this frame's whatever the others do (at 90 Hz:
+                // steps between frames, where that shows).
                 ch.dummy_bone_length = 0.04;
                 ch.target_framerate = 90.0;
                 ch.teleport_distance = 0.0;

@@ -898,14 +898,6 @@ impl Ctx<'_> {
             pack.prev_targets[p] = V3::select(m, t, pack.prev_targets[p]);
             pack.prev_normals[p] = V3::select(m, s.normals[p], pack.prev_normals[p]);
         }
-        let k = rig.colliders.len();
-        for l in 0..LANES {
-            if m.0[l] != 0 {
-                let lane = l * k..(l + 1) * k;
-                pack.prev_colliders[lane.clone()].copy_from_slice(&s.colliders[lane.clone()]);
-                s.step_placed_at[lane].fill(f32::NAN);
-            }
-        }
         pack.accumulator[ci] = F::select(m, F::splat(0.0), pack.accumulator[ci]);
         pack.last_step_component[ci] = Trs::select(m, &s.component, &pack.last_step_component[ci]);
         let h = 1.0 / set.target_framerate;

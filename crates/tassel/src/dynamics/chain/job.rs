@@ -290,8 +290,9 @@ fn reset_chain(rig: &ChainRig, ci: usize, state: &mut ChainState, component: &Tr
         state.prev_targets[p] = state.targets[p];
         state.prev_normals[p] = state.normals[p];
     }
-    state.prev_colliders.copy_from_slice(&state.colliders);
-    state.step_placed_at.fill(f32::NAN);
+    // The colliders' last placement is every chain's: a chain that starts again does not
+    // change how the others see the colliders move this frame (it takes no step of its
+    // own this frame, and the frame's end places them for all).
     state.accumulator[ci] = 0.0;
     state.last_step_component[ci] = *component;
     let s = &rig.chains[ci].settings;
