@@ -278,11 +278,13 @@ impl CharacterSim {
         &self.vrm_state
     }
 
-    /// Which code runs the solvers that have a SIMD lane path (today the VRM springs'
-    /// update): lanes by default, [`crate::crowd::SimdUse::Scalar`] for the readable
-    /// reference. Every choice gives the same bits.
+    /// Which code runs the solvers that have a SIMD lane path (the VRM springs' update and
+    /// the twin bone chains, [`ChainRig::lane_groups`]): lanes by default,
+    /// [`crate::crowd::SimdUse::Scalar`] for the readable reference. Every choice gives
+    /// the same bits.
     pub fn set_simd(&mut self, simd: crate::crowd::SimdUse) {
         self.vrm_state.set_simd(simd);
+        self.state.set_simd(simd);
     }
 
     /// Every joint a solver writes, ascending, each once (see

@@ -527,6 +527,150 @@ impl ChainCrowd {
     }
 }
 
+/// What one frame of a character's twin-chain lanes reads besides the chains' input.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct LaneFrame {
+    /// The character's world transform this frame.
+    pub component: Transform,
+    /// Frame time, seconds.
+    pub dt: f32,
+    /// Whether AVX2 may be used (where the CPU has it).
+    pub avx2: bool,
+}
+
+/// The lanes of [`super::chain_lanes`]: a lane group whose "characters" are twin chains of
+/// one character, run by the crowd's frame of one chain (`rig` is that chain as a rig of
+/// its own).
+#[derive(Debug, Clone)]
+pub(super) struct Twins {
+    pack: Pack,
+    scratch: Scratch,
+}
+
+impl Twins {
+    /// Lanes for `count` twins of `rig`'s one chain.
+    pub(super) fn new(rig: &ChainRig, count: usize) -> Twins {
+        let mut pack = Pack::new(rig);
+        pack.count = count;
+        Twins {
+            pack,
+            scratch: Scratch::new(rig, 0),
+        }
+    }
+
+    /// Lane `l` from chain `ci` (points from `start`) of the scalar state `s`.
+    pub(super) fn load_lane(
+        &mut self,
+        l: usize,
+        ci: usize,
+        start: usize,
+        s: &mut super::chain_lanes::ScalarChains,
+    ) {
+        let p = &mut self.pack;
+        for k in 0..p.pos.len() {
+            let q = start + k;
+            p.pos[k].set(l, s.pos[q]);
+            p.prev[k].set(l, s.prev[q]);
+            p.dev[k].set(l, s.dev[q]);
+            p.dev_before[k].set(l, s.dev_before[q]);
+            p.prev_targets[k].set(l, s.prev_targets[q]);
+            p.prev_normals[k].set(l, s.prev_normals[q]);
+        }
+        let m = p.prev_colliders.len() / LANES;
+        p.prev_colliders[l * m..(l + 1) * m].copy_from_slice(s.prev_colliders);
+        p.last_step_component[0].set(l, &s.last_step_component[ci]);
+        p.accumulator[0].0[l] = s.accumulator[ci];
+        p.dt_old[0].0[l] = s.dt_old[ci];
+        p.rng[0][l] = s.rng[ci];
+        p.needs_reset[0][l] = s.needs_reset[ci];
+        p.paths[l] = *s.path;
+        p.prev_component.set(l, &s.prev_component);
+        p.teleports[l] = 0;
+    }
+
+    /// Lane `l` back into chain `ci` (points from `start`) of the scalar state `s`.
+    pub(super) fn store_lane(
+        &mut self,
+        l: usize,
+        ci: usize,
+        start: usize,
+        s: &mut super::chain_lanes::ScalarChains,
+    ) {
+        let p = &mut self.pack;
+        for k in 0..p.pos.len() {
+            let q = start + k;
+            s.pos[q] = p.pos[k].get(l);
+            s.prev[q] = p.prev[k].get(l);
+            s.dev[q] = p.dev[k].get(l);
+            s.dev_before[q] = p.dev_before[k].get(l);
+            s.prev_targets[q] = p.prev_targets[k].get(l);
+            s.prev_normals[q] = p.prev_normals[k].get(l);
+        }
+        s.last_step_component[ci] = p.last_step_component[0].get(l);
+        s.accumulator[ci] = p.accumulator[0].0[l];
+        s.dt_old[ci] = p.dt_old[0].0[l];
+        s.rng[ci] = p.rng[0][l];
+        s.needs_reset[ci] = p.needs_reset[0][l];
+        *s.teleports += p.teleports[l];
+        p.teleports[l] = 0;
+    }
+
+    /// Every lane starts again from its pose on the next frame.
+    pub(super) fn reset(&mut self) {
+        self.pack.needs_reset[0] = [true; LANES];
+    }
+
+    /// Resets in the lanes in use since they were loaded.
+    pub(super) fn teleports(&self) -> u64 {
+        self.pack.teleports[..self.pack.count].iter().sum()
+    }
+
+    /// One frame: lane `l` reads the points of the chain starting at the `l`th of
+    /// `starts` in `targets` and `normals`, every lane the same placed `colliders`; the
+    /// lanes' output points are written back there into `out`.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn frame(
+        &mut self,
+        sk: &Skeleton,
+        rig: &ChainRig,
+        shapes: &[LaneShape],
+        frame: &LaneFrame,
+        starts: impl Iterator<Item = usize> + Clone,
+        targets: &[Vec3],
+        normals: &[Vec3],
+        colliders: &[PlacedCollider],
+        out: &mut [Vec3],
+    ) {
+        let (pack, s) = (&mut self.pack, &mut self.scratch);
+        let n = pack.pos.len();
+        let m = colliders.len();
+        for (l, start) in starts.clone().enumerate() {
+            for k in 0..n {
+                s.targets[k].set(l, targets[start + k]);
+                s.normals[k].set(l, normals[start + k]);
+            }
+            s.colliders[l * m..(l + 1) * m].copy_from_slice(colliders);
+            for (b, c) in s.bounds.iter_mut().zip(colliders) {
+                b.set(l, c);
+            }
+        }
+        s.component = Trs::splat(&frame.component);
+        Ctx {
+            sk,
+            rig,
+            shapes,
+            dt: frame.dt,
+            avx2: frame.avx2,
+        }
+        .run_chains_dispatch(pack, s);
+        for (l, start) in starts.enumerate() {
+            for k in 0..n {
+                out[start + k] = pack.out[k].get(l);
+            }
+        }
+    }
+}
+
 /// What every lane group's frame reads.
 struct Ctx<'c> {
     sk: &'c Skeleton,
@@ -757,6 +901,14 @@ impl Ctx<'_> {
     /// computed in the lane type `T`.
     #[inline(always)]
     fn step_lanes<T: Lane>(&self, pack: &mut Pack, s: &mut Scratch) {
+        self.run_chains::<T>(pack, s);
+        self.write_back(pack, s);
+    }
+
+    /// Every chain of the rig for the group's lanes, up to their output points (no
+    /// write-back).
+    #[inline(always)]
+    fn run_chains<T: Lane>(&self, pack: &mut Pack, s: &mut Scratch) {
         let rig = self.rig;
         let live = M::from_bools(std::array::from_fn(|l| l < pack.count));
         for l in 0..pack.count {
@@ -771,7 +923,27 @@ impl Ctx<'_> {
         pack.prev_normals.copy_from_slice(&s.normals);
         pack.prev_colliders.copy_from_slice(&s.colliders);
         pack.prev_component = s.component;
-        self.write_back(pack, s);
+    }
+
+    /// [`Ctx::run_chains`] with AVX2 where the CPU has it (as [`Ctx::step`]).
+    fn run_chains_dispatch(&self, pack: &mut Pack, s: &mut Scratch) {
+        #[cfg(target_arch = "x86_64")]
+        if self.avx2 && std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: `run_chains_avx2` only requires the AVX2 instructions, and the CPU
+            // was just checked to have them.
+            #[allow(unsafe_code)]
+            unsafe {
+                return self.run_chains_avx2(pack, s);
+            }
+        }
+        self.run_chains::<F>(pack, s)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn run_chains_avx2(&self, pack: &mut Pack, s: &mut Scratch) {
+        // The explicit AVX lane type, only here after the CPU was found to have AVX2.
+        self.run_chains::<Fa>(pack, s)
     }
 
     /// The chain job's `write_back` per lane: each rotator joint turned toward its

@@ -13,6 +13,7 @@
 #[cfg(target_arch = "x86_64")]
 mod avx;
 mod chain;
+pub(crate) mod chain_lanes;
 mod chain_step;
 pub mod lanes;
 pub(crate) mod spring_lanes;

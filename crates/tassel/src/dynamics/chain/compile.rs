@@ -50,7 +50,9 @@ pub struct ChainRig {
     // Write-back: joints that turn toward their simulated children, in joint order.
     pub(crate) rotators: Vec<(u16, u32, Range<u32>)>,
     pub(crate) rotator_children: Vec<u32>,
-    joint_count: usize,
+    /// Twin chains stepped side by side in SIMD lanes (see [`crate::crowd::chain_lanes`]).
+    pub(crate) lane_groups: Vec<crate::crowd::chain_lanes::ChainLaneGroup>,
+    pub(crate) joint_count: usize,
 }
 
 impl ChainRig {
@@ -75,6 +77,7 @@ impl ChainRig {
             limit_angle: Vec::new(),
             rotators: Vec::new(),
             rotator_children: Vec::new(),
+            lane_groups: Vec::new(),
             joint_count: skeleton.len(),
         };
         out.colliders = CompiledCollider::compile_all(skeleton, rig);
@@ -213,6 +216,7 @@ impl ChainRig {
             out.rotators
                 .push((j, p, s..out.rotator_children.len() as u32));
         }
+        out.lane_groups = crate::crowd::chain_lanes::plan(&out);
         Ok(out)
     }
 
@@ -286,6 +290,18 @@ impl ChainRig {
     /// Number of colliders.
     pub fn collider_count(&self) -> usize {
         self.colliders.len()
+    }
+
+    /// How many lane groups of twin chains (the same points, parameters, settings and
+    /// colliders; up to eight side by side in SIMD lanes) a `CharacterSim` steps
+    /// together; the other chains run the scalar step.
+    pub fn lane_groups(&self) -> usize {
+        self.lane_groups.len()
+    }
+
+    /// Whether chain `ci` is stepped in a lane group.
+    pub(crate) fn in_lane_group(&self, ci: usize) -> bool {
+        self.lane_groups.iter().any(|g| g.chains.contains(&ci))
     }
 
     /// The colliders chain `i` collides with.

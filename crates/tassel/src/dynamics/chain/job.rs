@@ -5,6 +5,8 @@ use super::settings::{PlanarAxis, TimeMode};
 use super::step::{step_chain, StepInput};
 use crate::collide::{NearSet, PlacedCollider};
 use crate::controller::Level;
+use crate::crowd::chain_lanes::{ChainLanes, LaneFrame, ScalarChains};
+use crate::crowd::SimdUse;
 use crate::dynamics::path::CharacterPath;
 use crate::dynamics::world::{push_out, WorldContact};
 use crate::error::{Error, Result};
@@ -50,6 +52,11 @@ pub struct ChainState {
     rng: Vec<SplitMix64>,
     needs_reset: Vec<bool>,
     teleports: u64,
+    /// Which code steps the rig's twin chains ([`ChainRig::lane_groups`]).
+    simd: SimdUse,
+    /// Each lane group's state, authoritative for its chains while `in_lanes`.
+    lanes: Vec<ChainLanes>,
+    in_lanes: bool,
 }
 
 impl ChainState {
@@ -88,12 +95,77 @@ impl ChainState {
             rng: (0..c).map(|ci| chain_rng(rig, ci)).collect(),
             needs_reset: vec![true; c],
             teleports: 0,
+            simd: SimdUse::default(),
+            lanes: rig.lane_groups.iter().map(ChainLanes::new).collect(),
+            in_lanes: false,
         }
+    }
+
+    /// Which code steps the twin chains: lanes by default ([`SimdUse::Auto`]),
+    /// [`SimdUse::Scalar`] for the readable reference. Every choice gives the same bits;
+    /// a change takes effect on the next frame, carrying the chains' state over.
+    pub fn set_simd(&mut self, simd: SimdUse) {
+        self.simd = simd;
+    }
+
+    /// The code chosen by [`ChainState::set_simd`].
+    pub fn simd(&self) -> SimdUse {
+        self.simd
+    }
+
+    /// Moves the lane groups' chains into their lanes (`to_lanes`) or back into the scalar
+    /// arrays.
+    fn move_lanes(&mut self, rig: &ChainRig, to_lanes: bool) {
+        let Self {
+            pos,
+            prev,
+            dev,
+            dev_before,
+            prev_targets,
+            prev_normals,
+            prev_colliders,
+            last_step_component,
+            accumulator,
+            dt_old,
+            rng,
+            needs_reset,
+            path,
+            prev_component,
+            teleports,
+            lanes,
+            ..
+        } = self;
+        let mut scalar = ScalarChains {
+            pos,
+            prev,
+            dev,
+            dev_before,
+            prev_targets,
+            prev_normals,
+            prev_colliders,
+            last_step_component,
+            accumulator,
+            dt_old,
+            rng,
+            needs_reset,
+            path,
+            prev_component: *prev_component,
+            teleports,
+        };
+        for (lanes, group) in lanes.iter_mut().zip(&rig.lane_groups) {
+            if to_lanes {
+                lanes.load(rig, group, &mut scalar);
+            } else {
+                lanes.store(rig, group, &mut scalar);
+            }
+        }
+        self.in_lanes = to_lanes;
     }
 
     /// Makes the next frame start again from the animated pose (velocities zero).
     pub fn reset(&mut self) {
         self.needs_reset.iter_mut().for_each(|r| *r = true);
+        self.lanes.iter_mut().for_each(ChainLanes::reset);
     }
 
     /// Tells the state that the character was moved on purpose: the next frame resets the
@@ -119,7 +191,7 @@ impl ChainState {
 
     /// How many resets a teleport (or a non-finite result) caused so far.
     pub fn teleport_count(&self) -> u64 {
-        self.teleports
+        self.teleports + self.lanes.iter().map(ChainLanes::teleports).sum::<u64>()
     }
 }
 
@@ -201,6 +273,10 @@ impl ChainJob<'_> {
             models,
             level,
         } = self;
+        let lanes = state.simd != SimdUse::Scalar && !rig.lane_groups.is_empty();
+        if lanes != state.in_lanes {
+            state.move_lanes(rig, lanes);
+        }
         gather_targets(
             skeleton,
             rig,
@@ -218,8 +294,31 @@ impl ChainJob<'_> {
         // One broad-phase query for the whole character; away from all geometry the
         // chains ask the level nothing more.
         let level = level.filter(|level| near_character(rig, state, &component, level));
+        // A chain's frame reads nothing of another chain's: the twin chains in lanes run
+        // after the others.
         for ci in 0..rig.chains.len() {
-            run_chain(rig, ci, state, &component, dt, level);
+            if !(lanes && rig.in_lane_group(ci)) {
+                run_chain(rig, ci, state, &component, dt, level);
+            }
+        }
+        if lanes {
+            let frame = LaneFrame {
+                component,
+                dt,
+                avx2: state.simd == SimdUse::Auto,
+            };
+            for (group, lanes) in rig.lane_groups.iter().zip(&mut state.lanes) {
+                lanes.frame(
+                    skeleton,
+                    rig,
+                    group,
+                    &frame,
+                    &state.targets,
+                    &state.normals,
+                    &state.colliders,
+                    &mut state.out,
+                );
+            }
         }
         state.prev_targets.copy_from_slice(&state.targets);
         state.prev_normals.copy_from_slice(&state.normals);

@@ -1,0 +1,250 @@
+//! One character's bone chains in SIMD lanes: up to [`LANES`] *twin* chains (the same
+//! points, per-point parameters, settings and collider list; hair strands, skirt chains,
+//! a fan of ribbons) side by side, one chain per lane, stepped by the chain crowd's lane
+//! arithmetic ([`super::chain_step`], through [`super::chain`]'s lane-group frame).
+//!
+//! The chain crowd's lanes are characters running the same chain; here they are chains
+//! of one character. The crowd's frame of one chain needs nothing else: each lane has
+//! its own points, targets, colliders (here the same placed colliders in every lane),
+//! character path (here the same), reset flags, step counts and wind generator, and a
+//! chain's frame reads nothing of another chain's. So a group gives each of its chains
+//! the bits the scalar job ([`crate::dynamics::chain::ChainJob`]) gives it: the scalar
+//! job is the readable reference ([`crate::crowd::SimdUse::Scalar`]) the lanes are
+//! tested against.
+
+pub(crate) use super::chain::LaneFrame;
+use super::chain::Twins;
+use super::chain_step::LaneShape;
+use super::lanes::LANES;
+use crate::collide::PlacedCollider;
+use crate::dynamics::chain::compile::{ChainRig, CompiledChain, NONE};
+use crate::dynamics::path::CharacterPath;
+use crate::math::Transform;
+use crate::rng::SplitMix64;
+use crate::skeleton::Skeleton;
+use glam::Vec3;
+
+/// Fewer twins than this run the scalar step: a lane group costs about as much as
+/// [`LANES`] scalar chains' arithmetic would share, and more in collisions.
+const MIN_TWINS: usize = 2;
+
+/// Twin chains of a rig, stepped together: lane `l` is `chains[l]`.
+#[derive(Debug, Clone)]
+pub(crate) struct ChainLaneGroup {
+    /// The chains, in rig order (2..=[`LANES`]).
+    pub chains: Vec<usize>,
+    /// The first chain as a rig of its own: its points from 0 (parents rebased), its
+    /// settings and collider list, every collider of the rig.
+    pub rig: ChainRig,
+    /// Each rig collider's shape as the lanes see it.
+    pub(super) shapes: Vec<LaneShape>,
+}
+
+/// The lane groups of `rig`: chains that do not collide with the world (the lanes have no
+/// level), grouped in rig order with their twins, groups of at least [`MIN_TWINS`].
+pub(crate) fn plan(rig: &ChainRig) -> Vec<ChainLaneGroup> {
+    let mut groups: Vec<Vec<usize>> = Vec::new();
+    for ci in 0..rig.chains.len() {
+        if rig.chains[ci].settings.world_collision {
+            continue;
+        }
+        match groups
+            .iter_mut()
+            .find(|g| g.len() < LANES && twins(rig, g[0], ci))
+        {
+            Some(g) => g.push(ci),
+            None => groups.push(vec![ci]),
+        }
+    }
+    groups
+        .into_iter()
+        .filter(|g| g.len() >= MIN_TWINS)
+        .map(|chains| {
+            let rig = one_chain(rig, chains[0]);
+            let shapes = rig
+                .colliders
+                .iter()
+                .map(|c| LaneShape::of(c.shape))
+                .collect();
+            ChainLaneGroup {
+                chains,
+                rig,
+                shapes,
+            }
+        })
+        .collect()
+}
+
+/// Whether chains `a` and `b` step alike: the same point tree (parents relative to the
+/// chain's first point), the same per-point parameters (bits), the same collider list,
+/// and the same settings but for the names, the curves (already in the per-point
+/// parameters), the dummy bone length (read only where the targets are gathered) and the
+/// wind's seed (each lane has its own generator).
+fn twins(rig: &ChainRig, a: usize, b: usize) -> bool {
+    let (ca, cb) = (&rig.chains[a], &rig.chains[b]);
+    if ca.points.len() != cb.points.len() || ca.colliders != cb.colliders {
+        return false;
+    }
+    let rebase = |p: u32, start: usize| {
+        if p == NONE {
+            NONE
+        } else {
+            p - start as u32
+        }
+    };
+    let same_points = ca.points.clone().zip(cb.points.clone()).all(|(p, q)| {
+        let bits = |v: &[f32]| (v[p].to_bits(), v[q].to_bits());
+        let same = |v: &[f32]| {
+            let (x, y) = bits(v);
+            x == y
+        };
+        rebase(rig.parent[p], ca.points.start) == rebase(rig.parent[q], cb.points.start)
+            && same(&rig.damping)
+            && same(&rig.stiffness)
+            && same(&rig.radius)
+            && same(&rig.wd_location)
+            && same(&rig.wd_rotation)
+            && same(&rig.limit_angle)
+    });
+    if !same_points {
+        return false;
+    }
+    let mut s = cb.settings.clone();
+    let r = &ca.settings;
+    s.name.clone_from(&r.name);
+    s.root.clone_from(&r.root);
+    s.exclude.clone_from(&r.exclude);
+    s.curves.clone_from(&r.curves);
+    s.dummy_bone_length = r.dummy_bone_length;
+    s.wind.seed = r.wind.seed;
+    s == *r
+}
+
+/// Chain `ci` of `rig` as a rig of one chain, its points from 0.
+fn one_chain(rig: &ChainRig, ci: usize) -> ChainRig {
+    let c = &rig.chains[ci];
+    let range = c.points.clone();
+    let slice = |v: &[f32]| v[range.clone()].to_vec();
+    ChainRig {
+        chains: vec![CompiledChain {
+            settings: c.settings.clone(),
+            points: 0..range.len(),
+            colliders: c.colliders.clone(),
+        }],
+        colliders: rig.colliders.clone(),
+        joint: rig.joint[range.clone()].to_vec(),
+        parent: rig.parent[range.clone()]
+            .iter()
+            .map(|&p| {
+                if p == NONE {
+                    NONE
+                } else {
+                    p - range.start as u32
+                }
+            })
+            .collect(),
+        chain_of: vec![0; range.len()],
+        dummy_length: slice(&rig.dummy_length),
+        damping: slice(&rig.damping),
+        stiffness: slice(&rig.stiffness),
+        radius: slice(&rig.radius),
+        wd_location: slice(&rig.wd_location),
+        wd_rotation: slice(&rig.wd_rotation),
+        limit_angle: slice(&rig.limit_angle),
+        rotators: Vec::new(),
+        rotator_children: Vec::new(),
+        lane_groups: Vec::new(),
+        joint_count: rig.joint_count(),
+    }
+}
+
+/// A character's per-chain state in the scalar job's layout (all chains, all points),
+/// for moving a group's chains into and out of their lanes.
+pub(crate) struct ScalarChains<'a> {
+    pub pos: &'a mut [Vec3],
+    pub prev: &'a mut [Vec3],
+    pub dev: &'a mut [Vec3],
+    pub dev_before: &'a mut [Vec3],
+    pub prev_targets: &'a mut [Vec3],
+    pub prev_normals: &'a mut [Vec3],
+    pub prev_colliders: &'a [PlacedCollider],
+    pub last_step_component: &'a mut [Transform],
+    pub accumulator: &'a mut [f32],
+    pub dt_old: &'a mut [f32],
+    pub rng: &'a mut [SplitMix64],
+    pub needs_reset: &'a mut [bool],
+    pub path: &'a CharacterPath,
+    pub prev_component: Transform,
+    pub teleports: &'a mut u64,
+}
+
+/// One lane group's state and working buffers.
+#[derive(Debug, Clone)]
+pub(crate) struct ChainLanes {
+    twins: Twins,
+}
+
+impl ChainLanes {
+    /// Fresh (unused) lanes for `group`: [`ChainLanes::load`] fills them.
+    pub(crate) fn new(group: &ChainLaneGroup) -> Self {
+        ChainLanes {
+            twins: Twins::new(&group.rig, group.chains.len()),
+        }
+    }
+
+    /// Takes the group's chains' state from the scalar layout.
+    pub(crate) fn load(&mut self, rig: &ChainRig, group: &ChainLaneGroup, s: &mut ScalarChains) {
+        for (l, &ci) in group.chains.iter().enumerate() {
+            let start = rig.chains[ci].points.start;
+            self.twins.load_lane(l, ci, start, s);
+        }
+    }
+
+    /// Gives the group's chains' state back to the scalar layout (their resets counted
+    /// there from now on).
+    pub(crate) fn store(&mut self, rig: &ChainRig, group: &ChainLaneGroup, s: &mut ScalarChains) {
+        for (l, &ci) in group.chains.iter().enumerate() {
+            let start = rig.chains[ci].points.start;
+            self.twins.store_lane(l, ci, start, s);
+        }
+    }
+
+    /// Makes every chain of the group start again from its pose on the next frame.
+    pub(crate) fn reset(&mut self) {
+        self.twins.reset();
+    }
+
+    /// Resets (teleports, non-finite results) in the lanes since they were loaded.
+    pub(crate) fn teleports(&self) -> u64 {
+        self.twins.teleports()
+    }
+
+    /// One frame of the group's chains, as the scalar job's `run_chain` for each: reads
+    /// the character's `targets`, `normals` (all points) and placed `colliders`, writes the
+    /// group's chains' output points into `out`.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn frame(
+        &mut self,
+        sk: &Skeleton,
+        rig: &ChainRig,
+        group: &ChainLaneGroup,
+        frame: &LaneFrame,
+        targets: &[Vec3],
+        normals: &[Vec3],
+        colliders: &[PlacedCollider],
+        out: &mut [Vec3],
+    ) {
+        let starts = group.chains.iter().map(|&ci| rig.chains[ci].points.start);
+        self.twins.frame(
+            sk,
+            &group.rig,
+            &group.shapes,
+            frame,
+            starts,
+            targets,
+            normals,
+            colliders,
+            out,
+        );
+    }
+}
