@@ -15,14 +15,14 @@
 pub(crate) use super::chain::LaneFrame;
 use super::chain::Twins;
 use super::chain_step::LaneShape;
-use super::lanes::LANES;
+use super::lanes::{rotation_arc, F, LANES, Q, V3};
 use crate::collide::PlacedCollider;
 use crate::dynamics::chain::compile::{ChainRig, CompiledChain, NONE};
 use crate::dynamics::path::CharacterPath;
 use crate::math::Transform;
 use crate::rng::SplitMix64;
 use crate::skeleton::Skeleton;
-use glam::Vec3;
+use glam::{Quat, Vec3};
 
 /// Fewer twins than this run the scalar step: a lane group costs about as much as
 /// [`LANES`] scalar chains' arithmetic would share, and more in collisions.
@@ -38,11 +38,39 @@ pub(crate) struct ChainLaneGroup {
     pub rig: ChainRig,
     /// Each rig collider's shape as the lanes see it.
     pub(super) shapes: Vec<LaneShape>,
+    /// The write-back of the group's rotator joints in lanes (`None`: a rotator's parent
+    /// joint is another chain's rotator, whose turn it would have to wait for; the scalar
+    /// write-back does those).
+    pub write_back: Option<Vec<LaneRotator>>,
+}
+
+/// The `k`th rotator joint of every chain of a group (twins have theirs at the same
+/// points).
+#[derive(Debug, Clone)]
+pub(crate) struct LaneRotator {
+    /// Its joint per lane.
+    joints: [u32; LANES],
+    /// Its point and its children's points, from the chain's first point.
+    point: usize,
+    kids: Vec<usize>,
+    /// Whose model rotation its local rotation is relative to.
+    parent: RotatorParent,
+}
+
+#[derive(Debug, Clone, Copy)]
+enum RotatorParent {
+    /// The group's rotator of this index (earlier in the list): its new rotation.
+    Rotator(usize),
+    /// A joint no chain turns, per lane: its animated model rotation.
+    Joint([u32; LANES]),
+    /// None (a skeleton root): the identity.
+    Root,
 }
 
 /// The lane groups of `rig`: chains that do not collide with the world (the lanes have no
 /// level), grouped in rig order with their twins, groups of at least [`MIN_TWINS`].
-pub(crate) fn plan(rig: &ChainRig) -> Vec<ChainLaneGroup> {
+pub(crate) fn plan(sk_parent: &[Option<usize>], full: &ChainRig) -> Vec<ChainLaneGroup> {
+    let rig = full;
     let mut groups: Vec<Vec<usize>> = Vec::new();
     for ci in 0..rig.chains.len() {
         if rig.chains[ci].settings.world_collision {
@@ -67,12 +95,86 @@ pub(crate) fn plan(rig: &ChainRig) -> Vec<ChainLaneGroup> {
                 .map(|c| LaneShape::of(c.shape))
                 .collect();
             ChainLaneGroup {
+                write_back: lane_rotators(sk_parent, full, &chains),
                 chains,
                 rig,
                 shapes,
             }
         })
         .collect()
+}
+
+/// The rotators of the twin `chains` lined up by index, or `None` when one's parent joint
+/// is a rotator of another chain (or of its own chain in a way the twins do not share).
+fn lane_rotators(
+    sk_parent: &[Option<usize>],
+    rig: &ChainRig,
+    chains: &[usize],
+) -> Option<Vec<LaneRotator>> {
+    let rotator_of_joint = |j: usize| rig.rotators.iter().position(|r| r.0 as usize == j);
+    // Each chain's rotators, in joint order.
+    let per_chain: Vec<Vec<usize>> = chains
+        .iter()
+        .map(|&ci| {
+            (0..rig.rotators.len())
+                .filter(|&r| {
+                    rig.chains[ci]
+                        .points
+                        .contains(&(rig.rotators[r].1 as usize))
+                })
+                .collect()
+        })
+        .collect();
+    let count = per_chain[0].len();
+    if per_chain.iter().any(|r| r.len() != count) {
+        return None;
+    }
+    let mut out = Vec::with_capacity(count);
+    for k in 0..count {
+        let mut joints = [0u32; LANES];
+        let mut parents = [0u32; LANES];
+        // (point, children, parent: none / a joint no chain turns / this chain's rotator k')
+        let mut shape: Option<(usize, Vec<usize>, Option<Option<usize>>)> = None;
+        for (l, &ci) in chains.iter().enumerate() {
+            let start = rig.chains[ci].points.start;
+            let (j, p, kids) = &rig.rotators[per_chain[l][k]];
+            let j = *j as usize;
+            let kids: Vec<usize> = rig.rotator_children[kids.start as usize..kids.end as usize]
+                .iter()
+                .map(|&c| c as usize - start)
+                .collect();
+            let parent = match sk_parent[j] {
+                None => None,
+                Some(q) => {
+                    parents[l] = q as u32;
+                    match rotator_of_joint(q) {
+                        None => Some(None),
+                        Some(r) => Some(Some(per_chain[l].iter().position(|&x| x == r)?)),
+                    }
+                }
+            };
+            joints[l] = j as u32;
+            let this = (*p as usize - start, kids, parent);
+            match &shape {
+                None => shape = Some(this),
+                Some(first) if *first == this => {}
+                Some(_) => return None,
+            }
+        }
+        let (point, kids, parent) = shape?;
+        out.push(LaneRotator {
+            joints,
+            point,
+            kids,
+            parent: match parent {
+                None => RotatorParent::Root,
+                Some(None) => RotatorParent::Joint(parents),
+                Some(Some(k2)) if k2 < k => RotatorParent::Rotator(k2),
+                Some(Some(_)) => return None,
+            },
+        });
+    }
+    Some(out)
 }
 
 /// Whether chains `a` and `b` step alike: the same point tree (parents relative to the
@@ -154,6 +256,7 @@ fn one_chain(rig: &ChainRig, ci: usize) -> ChainRig {
         rotators: Vec::new(),
         rotator_children: Vec::new(),
         lane_groups: Vec::new(),
+        rotator_in_lanes: Vec::new(),
         joint_count: rig.joint_count(),
     }
 }
@@ -217,6 +320,72 @@ impl ChainLanes {
     /// Resets (teleports, non-finite results) in the lanes since they were loaded.
     pub(crate) fn teleports(&self) -> u64 {
         self.twins.teleports()
+    }
+
+    /// The scalar job's `write_back` for the group's rotators (`group.write_back`), in
+    /// lanes: each rotator joint turned toward its simulated children (mean direction) on
+    /// top of its animated rotation. Runs before the scalar write-back of the others (no
+    /// rotator of the group depends on another chain's).
+    pub(crate) fn write_back(
+        rig: &ChainRig,
+        group: &ChainLaneGroup,
+        targets: &[Vec3],
+        out: &[Vec3],
+        locals: &mut [Transform],
+        models: &mut [Transform],
+        turned: &mut Vec<Q>,
+    ) {
+        let Some(rotators) = &group.write_back else {
+            return;
+        };
+        let starts: [usize; LANES] =
+            std::array::from_fn(|l| group.chains.get(l).map_or(group.chains[0], |&c| c))
+                .map(|ci| rig.chains[ci].points.start);
+        let count = group.chains.len();
+        let lanes = |off: usize, v: &[Vec3]| {
+            let mut x = V3::ZERO;
+            for (l, start) in starts.iter().enumerate() {
+                x.set(l, v[start + off]);
+            }
+            x
+        };
+        let zero = V3::splat(Vec3::ZERO);
+        let tiny = F::splat(1e-12);
+        turned.clear();
+        for (k, r) in rotators.iter().enumerate() {
+            let (ta, oa) = (lanes(r.point, targets), lanes(r.point, out));
+            let (mut anim, mut sim) = (zero, zero);
+            for &c in &r.kids {
+                anim = anim + (lanes(c, targets) - ta).normalize_or(zero);
+                sim = sim + (lanes(c, out) - oa).normalize_or(zero);
+            }
+            let skip = anim.dot(anim).lt(tiny).or(sim.dot(sim).lt(tiny));
+            let mut animated = Q::splat(Quat::IDENTITY);
+            for (l, &j) in r.joints.iter().enumerate().take(count) {
+                animated.set(l, models[j as usize].rotation);
+            }
+            let new_rot = rotation_arc(anim, sim).mul_quat(animated).normalize();
+            let parent_rot = match r.parent {
+                RotatorParent::Rotator(k2) => turned[k2],
+                RotatorParent::Joint(q) => {
+                    let mut p = Q::splat(Quat::IDENTITY);
+                    for (l, &j) in q.iter().enumerate().take(count) {
+                        p.set(l, models[j as usize].rotation);
+                    }
+                    p
+                }
+                RotatorParent::Root => Q::splat(Quat::IDENTITY),
+            };
+            let local = parent_rot.conjugate().mul_quat(new_rot).normalize();
+            for (l, &j) in r.joints.iter().enumerate().take(count) {
+                if skip.0[l] == 0 {
+                    locals[j as usize].rotation = local.get(l);
+                    models[j as usize].rotation = new_rot.get(l);
+                }
+            }
+            turned.push(Q::select(skip, animated, new_rot));
+            debug_assert_eq!(turned.len(), k + 1);
+        }
     }
 
     /// One frame of the group's chains, as the scalar job's `run_chain` for each: reads

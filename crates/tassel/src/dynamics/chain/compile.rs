@@ -52,6 +52,8 @@ pub struct ChainRig {
     pub(crate) rotator_children: Vec<u32>,
     /// Twin chains stepped side by side in SIMD lanes (see [`crate::crowd::chain_lanes`]).
     pub(crate) lane_groups: Vec<crate::crowd::chain_lanes::ChainLaneGroup>,
+    /// Per rotator: written back in a lane group's lanes (with the lanes on).
+    pub(crate) rotator_in_lanes: Vec<bool>,
     pub(crate) joint_count: usize,
 }
 
@@ -78,6 +80,7 @@ impl ChainRig {
             rotators: Vec::new(),
             rotator_children: Vec::new(),
             lane_groups: Vec::new(),
+            rotator_in_lanes: Vec::new(),
             joint_count: skeleton.len(),
         };
         out.colliders = CompiledCollider::compile_all(skeleton, rig);
@@ -216,7 +219,19 @@ impl ChainRig {
             out.rotators
                 .push((j, p, s..out.rotator_children.len() as u32));
         }
-        out.lane_groups = crate::crowd::chain_lanes::plan(&out);
+        let parents: Vec<Option<usize>> = (0..skeleton.len()).map(|j| skeleton.parent(j)).collect();
+        out.lane_groups = crate::crowd::chain_lanes::plan(&parents, &out);
+        out.rotator_in_lanes = vec![false; out.rotators.len()];
+        for g in out.lane_groups.iter().filter(|g| g.write_back.is_some()) {
+            for (r, (_, p, _)) in out.rotators.iter().enumerate() {
+                if g.chains
+                    .iter()
+                    .any(|&ci| out.chains[ci].points.contains(&(*p as usize)))
+                {
+                    out.rotator_in_lanes[r] = true;
+                }
+            }
+        }
         Ok(out)
     }
 

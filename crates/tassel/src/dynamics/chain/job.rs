@@ -57,6 +57,8 @@ pub struct ChainState {
     /// Each lane group's state, authoritative for its chains while `in_lanes`.
     lanes: Vec<ChainLanes>,
     in_lanes: bool,
+    /// Scratch of the lanes' write-back: each rotator's new model rotation.
+    turned: Vec<crate::crowd::lanes::Q>,
 }
 
 impl ChainState {
@@ -98,6 +100,7 @@ impl ChainState {
             simd: SimdUse::default(),
             lanes: rig.lane_groups.iter().map(ChainLanes::new).collect(),
             in_lanes: false,
+            turned: Vec::with_capacity(rig.rotators.len()),
         }
     }
 
@@ -325,7 +328,28 @@ impl ChainJob<'_> {
         state.prev_colliders.copy_from_slice(&state.colliders);
         state.prev_component = component;
 
-        write_back(skeleton, rig, &state.targets, &state.out, locals, models);
+        if lanes {
+            for group in &rig.lane_groups {
+                ChainLanes::write_back(
+                    rig,
+                    group,
+                    &state.targets,
+                    &state.out,
+                    locals,
+                    models,
+                    &mut state.turned,
+                );
+            }
+        }
+        write_back(
+            skeleton,
+            rig,
+            &state.targets,
+            &state.out,
+            locals,
+            models,
+            lanes,
+        );
         crate::pose::LocalToModelJob {
             skeleton,
             root: Transform::IDENTITY,
@@ -749,8 +773,12 @@ pub(crate) fn write_back(
     out: &[Vec3],
     locals: &mut [Transform],
     models: &mut [Transform],
+    lanes: bool,
 ) {
-    for (joint, point, kids) in &rig.rotators {
+    for (r, (joint, point, kids)) in rig.rotators.iter().enumerate() {
+        if lanes && rig.rotator_in_lanes[r] {
+            continue; // written back in its lane group, before
+        }
         let j = *joint as usize;
         let p = *point as usize;
         let mut anim = Vec3::ZERO;
