@@ -60,6 +60,10 @@ struct Pack {
     out_rotation: Vec<Q>,
     /// The first bad input of the last frame (lane, error): the group was not stepped.
     error: Option<(usize, Error)>,
+    /// Every lane is the same character (twin chains of one character: one path, one
+    /// transform, the same colliders): a lane's place on the path, placed colliders and
+    /// motion are copied from an earlier lane that asked the same, not computed again.
+    shared: bool,
 }
 
 impl Pack {
@@ -90,6 +94,7 @@ impl Pack {
             teleports: [0; LANES],
             out_rotation: vec![Q::splat(Quat::IDENTITY); rig.rotators.len()],
             error: None,
+            shared: false,
         }
     }
 
@@ -552,6 +557,7 @@ impl Twins {
     pub(super) fn new(rig: &ChainRig, count: usize) -> Twins {
         let mut pack = Pack::new(rig);
         pack.count = count;
+        pack.shared = true;
         Twins {
             pack,
             scratch: Scratch::new(rig, 0),
@@ -650,8 +656,12 @@ impl Twins {
                 s.normals[k].set(l, normals[start + k]);
             }
             s.colliders[l * m..(l + 1) * m].copy_from_slice(colliders);
-            for (b, c) in s.bounds.iter_mut().zip(colliders) {
-                b.set(l, c);
+        }
+        // The same colliders in every lane: each bound computed once.
+        for (b, c) in s.bounds.iter_mut().zip(colliders) {
+            b.set(0, c);
+            for l in 1..pack.count {
+                b.copy_lane(0, l);
             }
         }
         s.component = Trs::splat(&frame.component);
@@ -699,6 +709,7 @@ fn motion(
     dt: f32,
     fixed: bool,
     active: M,
+    shared: bool,
 ) -> Motion {
     let mut out = Motion {
         move_cs: V3::splat(Vec3::ZERO),
@@ -708,11 +719,28 @@ fn motion(
         wind_on: M::NONE,
     };
     let mut wind = [false; LANES];
-    for (l, wind) in wind.iter_mut().enumerate() {
+    let mut last: Option<usize> = None;
+    for l in 0..LANES {
         if active.0[l] == 0 {
             continue;
         }
         let b = to.get(l);
+        // One character in every lane: a lane whose transforms have the bits of the last
+        // lane computed gets that lane's motion.
+        if let Some(k) = last.filter(|&k| {
+            shared
+                && same_bits(&to.get(k), &b)
+                && from.is_none_or(|a| same_bits(&a.get(k), &a.get(l)))
+        }) {
+            out.move_cs.set(l, out.move_cs.get(k));
+            out.rotate_cs.set(l, out.rotate_cs.get(k));
+            out.gravity_step.set(l, out.gravity_step.get(k));
+            out.wind_cs.set(l, out.wind_cs.get(k));
+            wind[l] = wind[k];
+            continue;
+        }
+        last = Some(l);
+        let wind = &mut wind[l];
         if let Some(a) = from {
             let (m, r) = motion_cs(&a.get(l), &b);
             out.move_cs.set(l, m);
@@ -726,6 +754,15 @@ fn motion(
     }
     out.wind_on = M::from_bools(wind);
     out
+}
+
+/// Whether two transforms are the same bits.
+fn same_bits(a: &Transform, b: &Transform) -> bool {
+    let bits = |t: &Transform| {
+        let (p, q, k) = (t.translation, t.rotation, t.scale);
+        [p.x, p.y, p.z, q.x, q.y, q.z, q.w, k.x, k.y, k.z].map(f32::to_bits)
+    };
+    bits(a) == bits(b)
 }
 
 /// Checks one character's input: the pose's length, finite unit-rotation locals within
@@ -1077,7 +1114,7 @@ impl Ctx<'_> {
         // Warm-up: settle in place with the current targets and no character motion.
         let fixed = set.mode == TimeMode::Fixed;
         if set.warmup_steps > 0 {
-            let mo = motion(set, None, &s.component, h, fixed, m);
+            let mo = motion(set, None, &s.component, h, fixed, m, pack.shared);
             for _ in 0..set.warmup_steps {
                 let input = LaneStep {
                     targets: &s.targets,
@@ -1130,6 +1167,7 @@ impl Ctx<'_> {
                 dt,
                 false,
                 run,
+                pack.shared,
             );
             let input = LaneStep {
                 targets: &s.targets,
@@ -1208,20 +1246,43 @@ impl Ctx<'_> {
                     .lerp(s.normals[p], w)
                     .normalize_or(s.normals[p]);
             }
+            // With one character in every lane, a lane at the same share of the frame as
+            // the last lane placed gets that lane's placement.
+            let same = |l: usize, last: Option<usize>| {
+                last.filter(|&k| pack.shared && w.0[k].to_bits() == w.0[l].to_bits())
+            };
             for &c in &chain.colliders {
+                let mut last = None;
                 for l in 0..LANES {
                     let at = l * k_all + c;
                     if active.0[l] != 0 && s.step_placed_at[at].to_bits() != w.0[l].to_bits() {
-                        s.step_colliders[at] =
-                            pack.prev_colliders[at].lerp(&s.colliders[at], w.0[l]);
-                        s.step_bounds[c].set(l, &s.step_colliders[at]);
+                        match same(l, last) {
+                            Some(k) => {
+                                s.step_colliders[at] = s.step_colliders[k * k_all + c];
+                                s.step_bounds[c].copy_lane(k, l);
+                            }
+                            None => {
+                                s.step_colliders[at] =
+                                    pack.prev_colliders[at].lerp(&s.colliders[at], w.0[l]);
+                                s.step_bounds[c].set(l, &s.step_colliders[at]);
+                                last = Some(l);
+                            }
+                        }
                         s.step_placed_at[at] = w.0[l];
                     }
                 }
             }
+            let mut last = None;
             for l in 0..LANES {
                 if active.0[l] != 0 && s.path_w[l].to_bits() != w.0[l].to_bits() {
-                    s.path_at.set(l, &pack.paths[l].at(w.0[l]));
+                    let at = match same(l, last) {
+                        Some(k) => s.path_at.get(k),
+                        None => {
+                            last = Some(l);
+                            pack.paths[l].at(w.0[l])
+                        }
+                    };
+                    s.path_at.set(l, &at);
                     s.path_w[l] = w.0[l];
                 }
             }
@@ -1233,6 +1294,7 @@ impl Ctx<'_> {
                 h,
                 true,
                 active,
+                pack.shared,
             );
             let input = LaneStep {
                 targets: &s.step_targets,

@@ -38,6 +38,15 @@ impl Bound {
         b: V3::ZERO,
     };
 
+    /// Lane `to` as lane `from`.
+    #[inline]
+    pub(super) fn copy_lane(&mut self, from: usize, to: usize) {
+        self.c.set(to, self.c.get(from));
+        self.w.0[to] = self.w.0[from];
+        self.a.set(to, self.a.get(from));
+        self.b.set(to, self.b.get(from));
+    }
+
     /// Lane `l` from its placed collider.
     #[inline]
     pub(super) fn set(&mut self, l: usize, c: &PlacedCollider) {
