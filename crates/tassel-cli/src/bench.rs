@@ -2,7 +2,7 @@
 
 use std::sync::Arc;
 use std::time::Instant;
-use tassel::crowd::{ChainCrowd, CrowdPose, VrmCrowd};
+use tassel::crowd::{ChainCrowd, CrowdPose, SimdUse, VrmCrowd};
 use tassel::dynamics::chain::ChainRig;
 use tassel::dynamics::vrm::{VrmMode, VrmOptions, VrmRig};
 use tassel::dynamics::RigSettings;
@@ -36,6 +36,17 @@ pub struct Args {
     /// character, the same threads) in the same run and print the ratio.
     #[arg(long, requires = "crowd")]
     compare: bool,
+    /// Which code runs the solvers that have a lane path (VRM springs, twin chains) in
+    /// one character: `scalar` is the readable reference (the same bits, slower).
+    #[arg(long, value_enum, default_value_t = SimdBench::Auto, conflicts_with = "crowd")]
+    simd: SimdBench,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum SimdBench {
+    Scalar,
+    Portable,
+    Auto,
 }
 
 #[derive(Clone, Copy, clap::ValueEnum)]
@@ -132,6 +143,11 @@ pub fn run(a: Args) -> Result<(), String> {
         return crowd(&a, n);
     }
     let (mut sim, simulated, what) = character(&a)?;
+    sim.set_simd(match a.simd {
+        SimdBench::Scalar => SimdUse::Scalar,
+        SimdBench::Portable => SimdUse::Portable,
+        SimdBench::Auto => SimdUse::Auto,
+    });
     let rest = sim.skeleton().rest().to_vec();
     let dt = 1.0 / 60.0;
     let mut f = 0usize;
@@ -146,7 +162,12 @@ pub fn run(a: Args) -> Result<(), String> {
     };
     let samples = sorted_samples(a.runs, a.frames, &mut one_run)?;
     let median = samples[samples.len() / 2];
-    say!("tassel bench: {what}, single thread");
+    let code = match a.simd {
+        SimdBench::Scalar => "scalar reference",
+        SimdBench::Portable => "lanes without AVX2",
+        SimdBench::Auto => "lanes",
+    };
+    say!("tassel bench: {what}, single thread, {code}");
     say!(
         "  {simulated} simulated joints; median of {} runs x {} frames",
         samples.len(),
