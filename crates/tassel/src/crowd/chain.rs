@@ -621,6 +621,12 @@ impl Twins {
         p.teleports[l] = 0;
     }
 
+    /// The last frame's animated targets and output points, per point of the chain,
+    /// lane by lane.
+    pub(super) fn targets_and_out(&self) -> (&[V3], &[V3]) {
+        (&self.scratch.targets, &self.pack.out)
+    }
+
     /// Every lane starts again from its pose on the next frame.
     pub(super) fn reset(&mut self) {
         self.pack.needs_reset[0] = [true; LANES];
@@ -758,11 +764,11 @@ fn motion(
 
 /// Whether two transforms are the same bits.
 fn same_bits(a: &Transform, b: &Transform) -> bool {
-    let bits = |t: &Transform| {
-        let (p, q, k) = (t.translation, t.rotation, t.scale);
-        [p.x, p.y, p.z, q.x, q.y, q.z, q.w, k.x, k.y, k.z].map(f32::to_bits)
-    };
-    bits(a) == bits(b)
+    let v = |x: Vec3| x.to_array().map(f32::to_bits);
+    let q = |x: Quat| x.to_array().map(f32::to_bits);
+    v(a.translation) == v(b.translation)
+        && q(a.rotation) == q(b.rotation)
+        && v(a.scale) == v(b.scale)
 }
 
 /// Checks one character's input: the pose's length, finite unit-rotation locals within

@@ -327,10 +327,8 @@ impl ChainLanes {
     /// top of its animated rotation. Runs before the scalar write-back of the others (no
     /// rotator of the group depends on another chain's).
     pub(crate) fn write_back(
-        rig: &ChainRig,
+        &self,
         group: &ChainLaneGroup,
-        targets: &[Vec3],
-        out: &[Vec3],
         locals: &mut [Transform],
         models: &mut [Transform],
         turned: &mut Vec<Q>,
@@ -338,26 +336,18 @@ impl ChainLanes {
         let Some(rotators) = &group.write_back else {
             return;
         };
-        let starts: [usize; LANES] =
-            std::array::from_fn(|l| group.chains.get(l).map_or(group.chains[0], |&c| c))
-                .map(|ci| rig.chains[ci].points.start);
         let count = group.chains.len();
-        let lanes = |off: usize, v: &[Vec3]| {
-            let mut x = V3::ZERO;
-            for (l, start) in starts.iter().enumerate() {
-                x.set(l, v[start + off]);
-            }
-            x
-        };
+        // This frame's targets and output points, already in lanes.
+        let (targets, out) = self.twins.targets_and_out();
         let zero = V3::splat(Vec3::ZERO);
         let tiny = F::splat(1e-12);
         turned.clear();
         for (k, r) in rotators.iter().enumerate() {
-            let (ta, oa) = (lanes(r.point, targets), lanes(r.point, out));
+            let (ta, oa) = (targets[r.point], out[r.point]);
             let (mut anim, mut sim) = (zero, zero);
             for &c in &r.kids {
-                anim = anim + (lanes(c, targets) - ta).normalize_or(zero);
-                sim = sim + (lanes(c, out) - oa).normalize_or(zero);
+                anim = anim + (targets[c] - ta).normalize_or(zero);
+                sim = sim + (out[c] - oa).normalize_or(zero);
             }
             let skip = anim.dot(anim).lt(tiny).or(sim.dot(sim).lt(tiny));
             let mut animated = Q::splat(Quat::IDENTITY);

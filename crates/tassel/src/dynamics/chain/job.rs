@@ -329,16 +329,8 @@ impl ChainJob<'_> {
         state.prev_component = component;
 
         if lanes {
-            for group in &rig.lane_groups {
-                ChainLanes::write_back(
-                    rig,
-                    group,
-                    &state.targets,
-                    &state.out,
-                    locals,
-                    models,
-                    &mut state.turned,
-                );
+            for (group, lanes) in rig.lane_groups.iter().zip(&state.lanes) {
+                lanes.write_back(group, locals, models, &mut state.turned);
             }
         }
         write_back(
