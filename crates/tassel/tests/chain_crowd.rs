@@ -2,12 +2,13 @@
 //! chains): the same bits, frame after frame, for every character, whatever the thread
 //! count.
 
-use glam::{Quat, Vec3};
+mod common;
+
+use glam::Vec3;
 use std::sync::Arc;
-use tassel::collide::Shape;
 use tassel::crowd::{ChainCrowd, CrowdPose};
-use tassel::dynamics::chain::{ChainRig, ClassicGravity, PlanarAxis, TimeMode, Wind};
-use tassel::dynamics::{ColliderSettings, RigSettings};
+use tassel::dynamics::chain::{ChainRig, TimeMode, Wind};
+use tassel::dynamics::RigSettings;
 use tassel::{builtin, CharacterSim, Skeleton, Transform};
 
 /// Character `i`'s world transform and animated pose at frame `f`: its own phase of a
@@ -15,41 +16,8 @@ use tassel::{builtin, CharacterSim, Skeleton, Transform};
 /// at frame 100.
 fn motion(sk: &Skeleton, swing: usize, i: usize, f: usize, locals: &mut [Transform]) -> Transform {
     let t = f as f32 / 60.0 + 0.37 * i as f32;
-    locals.copy_from_slice(sk.rest());
-    locals[0].rotation = sk.rest()[0].rotation * Quat::from_rotation_z(0.3 * (2.0 * t).sin());
-    locals[swing].rotation =
-        sk.rest()[swing].rotation * Quat::from_rotation_x(0.5 * (3.0 * t + 1.0).sin());
     let jump = if i == 2 && f >= 100 { 10.0 } else { 0.0 };
-    Transform::from_translation_rotation(
-        Vec3::new((3.0 * t).sin() * 0.5 + jump, 0.1 * (5.0 * t).sin(), t),
-        Quat::from_rotation_y(0.4 * (2.0 * t).sin()),
-    )
-}
-
-/// Frame `f`'s time step: 60 Hz with a paused frame, a hitch and a slow stretch (lanes
-/// with different step counts after a reset).
-fn dt_at(f: usize) -> f32 {
-    match f {
-        200 => 0.0,
-        300 => 0.25,
-        320..=340 => 1.0 / 45.0,
-        _ => 1.0 / 60.0,
-    }
-}
-
-fn bits(t: &Transform) -> [u32; 10] {
-    let mut b = [0u32; 10];
-    for (k, v) in t
-        .translation
-        .to_array()
-        .into_iter()
-        .chain(t.rotation.to_array())
-        .chain(t.scale.to_array())
-        .enumerate()
-    {
-        b[k] = v.to_bits();
-    }
-    b
+    common::sway(sk, swing, t, jump, locals)
 }
 
 /// `n` characters through `frames` frames in a crowd and one `CharacterSim` each: every
@@ -83,7 +51,7 @@ fn assert_crowd_matches(
         for (i, (t, l)) in inputs.iter_mut().enumerate() {
             *t = motion(sk, swing, i, f, l);
         }
-        let dt = dt_at(f);
+        let dt = common::dt_with_hitches(f);
         crowd
             .frame(dt, |i| CrowdPose {
                 transform: inputs[i].0,
@@ -96,14 +64,18 @@ fn assert_crowd_matches(
             crowd.write_pose(i, &mut locals, &mut models).unwrap();
             for j in 0..sk.len() {
                 assert_eq!(
-                    bits(&locals[j]),
-                    bits(&pose.locals[j]),
+                    common::transform_bits(&locals[j]),
+                    common::transform_bits(&pose.locals[j]),
                     "frame {f}, character {i}, joint '{}': crowd {:?} vs single {:?}",
                     sk.name(j),
                     locals[j],
                     pose.locals[j]
                 );
-                assert_eq!(bits(&models[j]), bits(&pose.models[j]), "frame {f}");
+                assert_eq!(
+                    common::transform_bits(&models[j]),
+                    common::transform_bits(&pose.models[j]),
+                    "frame {f}"
+                );
             }
             let state = sim.chain_state();
             for (p, (single, target)) in state
@@ -171,76 +143,9 @@ fn chain_crowd_gives_the_single_character_bits_with_every_feature() {
     for (c, ch) in rig.chains.iter_mut().enumerate() {
         ch.stiffness = 0.2;
         ch.teleport_distance = 2.0;
-        match c {
-            0 => {
-                ch.wind = Wind {
-                    direction: Vec3::new(1.0, 0.0, 0.5),
-                    speed: 0.01,
-                    gust: 0.5,
-                    seed: 7,
-                }
-            }
-            1 => ch.limit_angle = 0.2,
-            2 => ch.planar_constraint = PlanarAxis::X,
-            3 => {
-                ch.mode = TimeMode::Classic;
-                ch.classic_gravity = ClassicGravity::DtSquared;
-            }
-            4 => {
-                ch.mode = TimeMode::Classic;
-                ch.classic_gravity = ClassicGravity::HalfDtSquared;
-                ch.planar_constraint = PlanarAxis::Z;
-            }
-            5 => {
-                ch.target_framerate = 90.0;
-                ch.max_steps_per_frame = 3;
-            }
-            6 => {
-                ch.warmup_steps = 5;
-                ch.alpha = 0.7;
-                ch.gravity_in_world = false;
-            }
-            7 => {
-                ch.target_framerate = 30.0;
-                ch.wind = Wind {
-                    direction: Vec3::Z,
-                    speed: 0.02,
-                    gust: 1.0,
-                    seed: 3,
-                };
-            }
-            _ => {
-                // Never resets on a jump, beside chains that do: it steps between last
-                // frame's colliders and this frame's whatever the others do (at 90 Hz:
-                // steps between frames, where that shows).
-                ch.dummy_bone_length = 0.04;
-                ch.target_framerate = 90.0;
-                ch.teleport_distance = 0.0;
-                ch.teleport_rotation = 0.0;
-            }
-        }
+        common::chain_feature(ch, c, 7);
     }
-    rig.colliders[1].shape = Shape::Box {
-        half_extents: Vec3::new(0.05, 0.08, 0.03),
-    };
-    rig.colliders[3].rotation = Quat::from_rotation_z(0.6);
-    rig.colliders.push(ColliderSettings {
-        name: "floor".into(),
-        bone: "root".into(),
-        offset: Vec3::new(0.0, -0.32, 0.0),
-        rotation: Quat::from_rotation_x(0.1),
-        shape: Shape::Plane,
-    });
-    rig.colliders.push(ColliderSettings {
-        name: "limit".into(),
-        bone: "root".into(),
-        offset: Vec3::ZERO,
-        rotation: Quat::IDENTITY,
-        shape: Shape::Sphere {
-            radius: 0.38,
-            inside: true,
-        },
-    });
+    common::every_collider_shape(&mut rig);
     let swung = assert_crowd_matches(&sk, &rig, 2, 13, 600);
     assert!(swung > 0.02, "chains barely moved ({swung} m)");
 }
@@ -427,8 +332,8 @@ fn chain_crowd_removes_and_adds_characters() {
             crowd.write_pose(i, &mut locals, &mut models).unwrap();
             for j in 0..sk.len() {
                 assert_eq!(
-                    bits(&locals[j]),
-                    bits(&pose.locals[j]),
+                    common::transform_bits(&locals[j]),
+                    common::transform_bits(&pose.locals[j]),
                     "frame {f}, index {i} (character {who}), joint {j}"
                 );
             }

@@ -3,46 +3,18 @@
 //! use every chain feature and collider shape, with chains the lanes do not take beside
 //! them, and when the code is switched between frames.
 
-use glam::{Quat, Vec3};
-use tassel::collide::Shape;
+mod common;
+
 use tassel::crowd::SimdUse;
-use tassel::dynamics::chain::{ChainRig, ClassicGravity, PlanarAxis, TimeMode, Wind};
-use tassel::dynamics::{ColliderSettings, RigSettings};
+use tassel::dynamics::chain::{ChainRig, TimeMode};
+use tassel::dynamics::RigSettings;
 use tassel::{builtin, CharacterSim, Skeleton, Transform};
 
 /// The character's world transform and animated pose at frame `f`: a sway, a bob and a
 /// turn, the root and joint `swing` swinging, a 10 m jump at frame 450.
 fn motion(sk: &Skeleton, swing: usize, f: usize, locals: &mut [Transform]) -> Transform {
-    let t = f as f32 / 60.0;
-    locals.copy_from_slice(sk.rest());
-    locals[0].rotation = sk.rest()[0].rotation * Quat::from_rotation_z(0.3 * (2.0 * t).sin());
-    locals[swing].rotation =
-        sk.rest()[swing].rotation * Quat::from_rotation_x(0.5 * (3.0 * t + 1.0).sin());
     let jump = if f >= 450 { 10.0 } else { 0.0 };
-    Transform::from_translation_rotation(
-        Vec3::new((3.0 * t).sin() * 0.5 + jump, 0.1 * (5.0 * t).sin(), t),
-        Quat::from_rotation_y(0.6 * (2.0 * t).sin()),
-    )
-}
-
-/// 60 Hz with a paused frame, a hitch and a slow stretch.
-fn dt_at(f: usize) -> f32 {
-    match f {
-        200 => 0.0,
-        300 => 0.25,
-        320..=340 => 1.0 / 45.0,
-        _ => 1.0 / 60.0,
-    }
-}
-
-fn bits(t: &Transform) -> [u32; 10] {
-    let mut b = [0u32; 10];
-    let all = t.translation.to_array().into_iter();
-    let all = all.chain(t.rotation.to_array()).chain(t.scale.to_array());
-    for (k, v) in all.enumerate() {
-        b[k] = v.to_bits();
-    }
-    b
+    common::sway(sk, swing, f as f32 / 60.0, jump, locals)
 }
 
 /// One character per way of running the chains (scalar, portable lanes, AVX2 lanes where
@@ -80,7 +52,7 @@ fn assert_lanes_match(sk: &Skeleton, rig: &RigSettings, swing: usize, frames: us
             sims[3].set_simd(simd);
         }
         let component = motion(sk, swing, f, &mut locals);
-        let dt = dt_at(f);
+        let dt = common::dt_with_hitches(f);
         let poses: Vec<_> = sims
             .iter_mut()
             .map(|sim| sim.frame(&locals, component, dt).unwrap().clone())
@@ -89,15 +61,18 @@ fn assert_lanes_match(sk: &Skeleton, rig: &RigSettings, swing: usize, frames: us
         for (k, (sim, pose)) in sims.iter().zip(&poses).enumerate().skip(1) {
             for j in 0..sk.len() {
                 assert_eq!(
-                    bits(&pose.locals[j]),
-                    bits(&poses[0].locals[j]),
+                    common::transform_bits(&pose.locals[j]),
+                    common::transform_bits(&poses[0].locals[j]),
                     "frame {f}, way {k} ({:?}), joint '{}': {:?} vs scalar {:?}",
                     ways[k],
                     sk.name(j),
                     pose.locals[j],
                     poses[0].locals[j]
                 );
-                assert_eq!(bits(&pose.models[j]), bits(&poses[0].models[j]));
+                assert_eq!(
+                    common::transform_bits(&pose.models[j]),
+                    common::transform_bits(&poses[0].models[j])
+                );
             }
             let (a, b) = (sim.chain_state(), reference.chain_state());
             for (p, (x, y)) in a
@@ -151,77 +126,14 @@ fn twin_chains_in_lanes_give_the_scalar_bits_with_every_feature() {
         ch.teleport_distance = 2.0;
         // Different seeds among twins: each lane has its own wind generator.
         ch.wind.seed = c as u64;
-        match c / 3 {
-            0 => {
-                ch.wind = Wind {
-                    direction: Vec3::new(1.0, 0.0, 0.5),
-                    speed: 0.01,
-                    gust: 0.5,
-                    seed: c as u64,
-                }
-            }
-            1 => ch.limit_angle = 0.2,
-            2 => ch.planar_constraint = PlanarAxis::X,
-            3 => {
-                ch.mode = TimeMode::Classic;
-                ch.classic_gravity = ClassicGravity::DtSquared;
-            }
-            4 => {
-                ch.mode = TimeMode::Classic;
-                ch.classic_gravity = ClassicGravity::HalfDtSquared;
-                ch.planar_constraint = PlanarAxis::Z;
-            }
-            5 => {
-                ch.target_framerate = 90.0;
-                ch.max_steps_per_frame = 3;
-            }
-            6 => {
-                ch.warmup_steps = 5;
-                ch.alpha = 0.7;
-                ch.gravity_in_world = false;
-            }
-            7 => {
-                ch.target_framerate = 30.0;
-                ch.wind = Wind {
-                    direction: Vec3::Z,
-                    speed: 0.02,
-                    gust: 1.0,
-                    seed: 3 + c as u64,
-                };
-            }
-            8 => {
-                // Never resets on a jump, beside chains that do.
-                ch.dummy_bone_length = 0.04;
-                ch.target_framerate = 90.0;
-                ch.teleport_distance = 0.0;
-                ch.teleport_rotation = 0.0;
-            }
-            9 if c == 27 => ch.damping = 0.3, // one of a kind: scalar
-            9 if c == 28 => ch.world_collision = true, // the lanes have no world: scalar
-            _ => {}                           // eleven plain twins: 8 + 3
+        match c {
+            0..=26 => common::chain_feature(ch, c / 3, c as u64),
+            27 => ch.damping = 0.3,          // one of a kind: scalar
+            28 => ch.world_collision = true, // the lanes have no world: scalar
+            _ => {}                          // eleven plain twins: 8 + 3
         }
     }
-    rig.colliders[1].shape = Shape::Box {
-        half_extents: Vec3::new(0.05, 0.08, 0.03),
-    };
-    rig.colliders[3].rotation = Quat::from_rotation_z(0.6);
-    rig.colliders.push(ColliderSettings {
-        name: "floor".into(),
-        bone: "root".into(),
-        offset: Vec3::new(0.0, -0.32, 0.0),
-        rotation: Quat::from_rotation_x(0.1),
-        shape: Shape::Plane,
-    });
-    rig.colliders.push(ColliderSettings {
-        name: "limit".into(),
-        bone: "root".into(),
-        offset: Vec3::ZERO,
-        rotation: Quat::IDENTITY,
-        shape: Shape::Sphere {
-            radius: 0.38,
-            inside: true,
-        },
-    });
+    common::every_collider_shape(&mut rig);
     let chains = ChainRig::new(&sk, &rig).unwrap();
     // Nine features of three, the plain chains (29, 30..=39): 29 and 30..=36, then 37..=39.
     assert_eq!(chains.lane_groups(), 11);

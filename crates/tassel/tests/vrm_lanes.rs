@@ -2,6 +2,8 @@
 //! scalar update (the readable reference): the same bits, frame after frame, in every
 //! mode, on rigs that use every part of the lane plan.
 
+mod common;
+
 use glam::{Quat, Vec3};
 use tassel::crowd::SimdUse;
 use tassel::dynamics::vrm::{
@@ -32,16 +34,6 @@ fn dt_at(f: usize) -> f32 {
         300 => 0.25,
         _ => 1.0 / 60.0,
     }
-}
-
-fn bits(t: &Transform) -> [u32; 10] {
-    let mut b = [0u32; 10];
-    let all = t.translation.to_array().into_iter();
-    let all = all.chain(t.rotation.to_array()).chain(t.scale.to_array());
-    for (k, v) in all.enumerate() {
-        b[k] = v.to_bits();
-    }
-    b
 }
 
 /// One character per way of running the update (scalar, portable lanes, AVX2 lanes where
@@ -91,8 +83,14 @@ fn assert_lanes_match(
             let pose = sim.frame(&locals, transform, dt).unwrap();
             for j in 0..sk.len() {
                 assert_eq!(
-                    (bits(&pose.locals[j]), bits(&pose.models[j])),
-                    (bits(&reference.locals[j]), bits(&reference.models[j])),
+                    (
+                        common::transform_bits(&pose.locals[j]),
+                        common::transform_bits(&pose.models[j])
+                    ),
+                    (
+                        common::transform_bits(&reference.locals[j]),
+                        common::transform_bits(&reference.models[j])
+                    ),
                     "{mode:?} at {step_rate} Hz, {w:?}: frame {f}, joint '{}': {:?} vs {:?}",
                     sk.name(j),
                     pose.locals[j],
@@ -107,8 +105,8 @@ fn assert_lanes_match(
             assert_eq!(sim.animated_models().len(), got.len());
             for j in 0..sk.len() {
                 assert_eq!(
-                    bits(&got[j]),
-                    bits(&animated[j]),
+                    common::transform_bits(&got[j]),
+                    common::transform_bits(&animated[j]),
                     "{w:?}: frame {f}, animated model of '{}'",
                     sk.name(j)
                 );

@@ -521,7 +521,7 @@ impl ChainCrowd {
                     let base = (c * chunk + k) * LANES;
                     pack.error = ctx.gather(pack, scratch, base, input).err();
                     if pack.error.is_none() {
-                        ctx.step(pack, scratch);
+                        ctx.step(pack, scratch, true);
                     }
                 }
             });
@@ -678,7 +678,7 @@ impl Twins {
             dt: frame.dt,
             avx2: frame.avx2,
         }
-        .run_chains_dispatch(pack, s);
+        .step(pack, s, false);
         for (l, start) in starts.enumerate() {
             for k in 0..n {
                 out[start + k] = pack.out[k].get(l);
@@ -920,32 +920,36 @@ impl Ctx<'_> {
     /// (the steps in the explicit AVX lane type, `crowd/avx.rs`), else over `F` with the
     /// baseline SSE2. Every lane operation of both is IEEE-exact, so both give the same
     /// bits.
-    fn step(&self, pack: &mut Pack, s: &mut Scratch) {
+    /// `write_back`: also the rotators' rotations per lane (a crowd's characters; twin
+    /// chains have their own write-back).
+    fn step(&self, pack: &mut Pack, s: &mut Scratch, write_back: bool) {
         #[cfg(target_arch = "x86_64")]
         if self.avx2 && std::arch::is_x86_feature_detected!("avx2") {
             // SAFETY: `step_avx2` only requires the AVX2 instructions, and the CPU was
             // just checked to have them.
             #[allow(unsafe_code)]
             unsafe {
-                return self.step_avx2(pack, s);
+                return self.step_avx2(pack, s, write_back);
             }
         }
-        self.step_lanes::<F>(pack, s)
+        self.step_lanes::<F>(pack, s, write_back)
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    fn step_avx2(&self, pack: &mut Pack, s: &mut Scratch) {
+    fn step_avx2(&self, pack: &mut Pack, s: &mut Scratch, write_back: bool) {
         // The explicit AVX lane type, only here after the CPU was found to have AVX2.
-        self.step_lanes::<Fa>(pack, s)
+        self.step_lanes::<Fa>(pack, s, write_back)
     }
 
     /// One frame of one lane group whose input is in `scratch`; the solver steps
     /// computed in the lane type `T`.
     #[inline(always)]
-    fn step_lanes<T: Lane>(&self, pack: &mut Pack, s: &mut Scratch) {
+    fn step_lanes<T: Lane>(&self, pack: &mut Pack, s: &mut Scratch, write_back: bool) {
         self.run_chains::<T>(pack, s);
-        self.write_back(pack, s);
+        if write_back {
+            self.write_back(pack, s);
+        }
     }
 
     /// Every chain of the rig for the group's lanes, up to their output points (no
@@ -966,27 +970,6 @@ impl Ctx<'_> {
         pack.prev_normals.copy_from_slice(&s.normals);
         pack.prev_colliders.copy_from_slice(&s.colliders);
         pack.prev_component = s.component;
-    }
-
-    /// [`Ctx::run_chains`] with AVX2 where the CPU has it (as [`Ctx::step`]).
-    fn run_chains_dispatch(&self, pack: &mut Pack, s: &mut Scratch) {
-        #[cfg(target_arch = "x86_64")]
-        if self.avx2 && std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: `run_chains_avx2` only requires the AVX2 instructions, and the CPU
-            // was just checked to have them.
-            #[allow(unsafe_code)]
-            unsafe {
-                return self.run_chains_avx2(pack, s);
-            }
-        }
-        self.run_chains::<F>(pack, s)
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    fn run_chains_avx2(&self, pack: &mut Pack, s: &mut Scratch) {
-        // The explicit AVX lane type, only here after the CPU was found to have AVX2.
-        self.run_chains::<Fa>(pack, s)
     }
 
     /// The chain job's `write_back` per lane: each rotator joint turned toward its

@@ -115,3 +115,125 @@ pub mod hair {
         }
     }
 }
+
+/// A transform's bits: translation, rotation, scale.
+pub fn transform_bits(t: &Transform) -> [u32; 10] {
+    let mut b = [0u32; 10];
+    let all = t.translation.to_array().into_iter();
+    let all = all.chain(t.rotation.to_array()).chain(t.scale.to_array());
+    for (k, v) in all.enumerate() {
+        b[k] = v.to_bits();
+    }
+    b
+}
+
+/// How many chain features [`chain_feature`] knows.
+pub const CHAIN_FEATURES: usize = 9;
+
+/// Gives `ch` chain feature `feature` (0..[`CHAIN_FEATURES`]): wind with gusts, a cone
+/// limit, the planar constraints, classic mode with each gravity rule, fixed steps at
+/// 90 Hz (steps between frames, a powf pull) with a step cap, warm-up steps with alpha
+/// and gravity in the character's space, 30 Hz with wind, and a dummy tip on a chain
+/// that never resets on a jump (90 Hz: steps between frames). `seed` seeds the wind.
+pub fn chain_feature(ch: &mut tassel::dynamics::chain::ChainSettings, feature: usize, seed: u64) {
+    use tassel::dynamics::chain::{ClassicGravity, PlanarAxis, TimeMode, Wind};
+    match feature {
+        0 => {
+            ch.wind = Wind {
+                direction: Vec3::new(1.0, 0.0, 0.5),
+                speed: 0.01,
+                gust: 0.5,
+                seed,
+            }
+        }
+        1 => ch.limit_angle = 0.2,
+        2 => ch.planar_constraint = PlanarAxis::X,
+        3 => {
+            ch.mode = TimeMode::Classic;
+            ch.classic_gravity = ClassicGravity::DtSquared;
+        }
+        4 => {
+            ch.mode = TimeMode::Classic;
+            ch.classic_gravity = ClassicGravity::HalfDtSquared;
+            ch.planar_constraint = PlanarAxis::Z;
+        }
+        5 => {
+            ch.target_framerate = 90.0;
+            ch.max_steps_per_frame = 3;
+        }
+        6 => {
+            ch.warmup_steps = 5;
+            ch.alpha = 0.7;
+            ch.gravity_in_world = false;
+        }
+        7 => {
+            ch.target_framerate = 30.0;
+            ch.wind = Wind {
+                direction: Vec3::Z,
+                speed: 0.02,
+                gust: 1.0,
+                seed: seed + 3,
+            };
+        }
+        _ => {
+            // Never resets on a jump, beside chains that do.
+            ch.dummy_bone_length = 0.04;
+            ch.target_framerate = 90.0;
+            ch.teleport_distance = 0.0;
+            ch.teleport_rotation = 0.0;
+        }
+    }
+}
+
+/// Every collider shape in a bench rig (`builtin::bench_character` with at least four
+/// colliders: spheres and capsules): collider 1 becomes a box, collider 3 a turned
+/// capsule, and a tilted floor plane and a keep-inside sphere join them.
+pub fn every_collider_shape(rig: &mut tassel::dynamics::RigSettings) {
+    use tassel::collide::Shape;
+    use tassel::dynamics::ColliderSettings;
+    rig.colliders[1].shape = Shape::Box {
+        half_extents: Vec3::new(0.05, 0.08, 0.03),
+    };
+    rig.colliders[3].rotation = Quat::from_rotation_z(0.6);
+    rig.colliders.push(ColliderSettings {
+        name: "floor".into(),
+        bone: "root".into(),
+        offset: Vec3::new(0.0, -0.32, 0.0),
+        rotation: Quat::from_rotation_x(0.1),
+        shape: Shape::Plane,
+    });
+    rig.colliders.push(ColliderSettings {
+        name: "limit".into(),
+        bone: "root".into(),
+        offset: Vec3::ZERO,
+        rotation: Quat::IDENTITY,
+        shape: Shape::Sphere {
+            radius: 0.38,
+            inside: true,
+        },
+    });
+}
+
+/// A character's world transform and animated pose at time `t`: a sway, a bob and a
+/// turn, the root and joint `swing` swinging, moved `jump` metres along x.
+pub fn sway(sk: &Skeleton, swing: usize, t: f32, jump: f32, locals: &mut [Transform]) -> Transform {
+    locals.copy_from_slice(sk.rest());
+    locals[0].rotation = sk.rest()[0].rotation * Quat::from_rotation_z(0.3 * (2.0 * t).sin());
+    locals[swing].rotation =
+        sk.rest()[swing].rotation * Quat::from_rotation_x(0.5 * (3.0 * t + 1.0).sin());
+    Transform::from_translation_rotation(
+        Vec3::new((3.0 * t).sin() * 0.5 + jump, 0.1 * (5.0 * t).sin(), t),
+        Quat::from_rotation_y(0.4 * (2.0 * t).sin()),
+    )
+}
+
+/// Frame `f`'s time step: 60 Hz with a paused frame (200), a hitch (300) and a slow
+/// stretch (320..=340: steps between frames).
+pub fn dt_with_hitches(f: usize) -> f32 {
+    match f {
+        200 => 0.0,
+        300 => 0.25,
+        320..=340 => 1.0 / 45.0,
+        _ => 1.0 / 60.0,
+    }
+}

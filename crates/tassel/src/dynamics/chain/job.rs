@@ -119,43 +119,24 @@ impl ChainState {
     /// Moves the lane groups' chains into their lanes (`to_lanes`) or back into the scalar
     /// arrays.
     fn move_lanes(&mut self, rig: &ChainRig, to_lanes: bool) {
-        let Self {
-            pos,
-            prev,
-            dev,
-            dev_before,
-            prev_targets,
-            prev_normals,
-            prev_colliders,
-            last_step_component,
-            accumulator,
-            dt_old,
-            rng,
-            needs_reset,
-            path,
-            prev_component,
-            teleports,
-            lanes,
-            ..
-        } = self;
         let mut scalar = ScalarChains {
-            pos,
-            prev,
-            dev,
-            dev_before,
-            prev_targets,
-            prev_normals,
-            prev_colliders,
-            last_step_component,
-            accumulator,
-            dt_old,
-            rng,
-            needs_reset,
-            path,
-            prev_component: *prev_component,
-            teleports,
+            pos: &mut self.pos,
+            prev: &mut self.prev,
+            dev: &mut self.dev,
+            dev_before: &mut self.dev_before,
+            prev_targets: &mut self.prev_targets,
+            prev_normals: &mut self.prev_normals,
+            prev_colliders: &self.prev_colliders,
+            last_step_component: &mut self.last_step_component,
+            accumulator: &mut self.accumulator,
+            dt_old: &mut self.dt_old,
+            rng: &mut self.rng,
+            needs_reset: &mut self.needs_reset,
+            path: &self.path,
+            prev_component: self.prev_component,
+            teleports: &mut self.teleports,
         };
-        for (lanes, group) in lanes.iter_mut().zip(&rig.lane_groups) {
+        for (lanes, group) in self.lanes.iter_mut().zip(&rig.lane_groups) {
             if to_lanes {
                 lanes.load(rig, group, &mut scalar);
             } else {
