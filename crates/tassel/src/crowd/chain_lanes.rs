@@ -15,7 +15,7 @@
 pub(crate) use super::chain::LaneFrame;
 use super::chain::Twins;
 use super::chain_step::LaneShape;
-use super::lanes::{rotation_arc, F, LANES, Q, V3};
+use super::lanes::{rotation_arc, Lane, Mask, F, LANES, Q, V3};
 use crate::collide::PlacedCollider;
 use crate::dynamics::chain::compile::{ChainRig, CompiledChain, NONE};
 use crate::dynamics::path::CharacterPath;
@@ -332,29 +332,68 @@ impl ChainLanes {
         locals: &mut [Transform],
         models: &mut [Transform],
         turned: &mut Vec<Q>,
+        avx2: bool,
     ) {
         let Some(rotators) = &group.write_back else {
             return;
         };
+        #[cfg(target_arch = "x86_64")]
+        if avx2 && std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: `write_back_avx2` only requires the AVX2 instructions, and the CPU
+            // was just checked to have them.
+            #[allow(unsafe_code)]
+            unsafe {
+                return self.write_back_avx2(group, rotators, locals, models, turned);
+            }
+        }
+        self.write_back_lanes::<F>(group, rotators, locals, models, turned)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn write_back_avx2(
+        &self,
+        group: &ChainLaneGroup,
+        rotators: &[LaneRotator],
+        locals: &mut [Transform],
+        models: &mut [Transform],
+        turned: &mut Vec<Q>,
+    ) {
+        // The explicit AVX lane type, only here after the CPU was found to have AVX2.
+        self.write_back_lanes::<super::avx::Fa>(group, rotators, locals, models, turned)
+    }
+
+    /// [`ChainLanes::write_back`] computed in the lane type `T`.
+    #[inline(always)]
+    fn write_back_lanes<T: Lane>(
+        &self,
+        group: &ChainLaneGroup,
+        rotators: &[LaneRotator],
+        locals: &mut [Transform],
+        models: &mut [Transform],
+        turned: &mut Vec<Q>,
+    ) {
         let count = group.chains.len();
         // This frame's targets and output points, already in lanes.
         let (targets, out) = self.twins.targets_and_out();
-        let zero = V3::splat(Vec3::ZERO);
-        let tiny = F::splat(1e-12);
+        let zero = V3::<T>::splat(Vec3::ZERO);
+        let tiny = T::splat(1e-12);
         turned.clear();
         for (k, r) in rotators.iter().enumerate() {
-            let (ta, oa) = (targets[r.point], out[r.point]);
+            let (ta, oa) = (V3::<T>::of(targets[r.point]), V3::<T>::of(out[r.point]));
             let (mut anim, mut sim) = (zero, zero);
             for &c in &r.kids {
-                anim = anim + (targets[c] - ta).normalize_or(zero);
-                sim = sim + (out[c] - oa).normalize_or(zero);
+                anim = anim + (V3::<T>::of(targets[c]) - ta).normalize_or(zero);
+                sim = sim + (V3::<T>::of(out[c]) - oa).normalize_or(zero);
             }
-            let skip = anim.dot(anim).lt(tiny).or(sim.dot(sim).lt(tiny));
+            let skip = anim.dot(anim).lt(tiny).or(sim.dot(sim).lt(tiny)).m();
             let mut animated = Q::splat(Quat::IDENTITY);
             for (l, &j) in r.joints.iter().enumerate().take(count) {
                 animated.set(l, models[j as usize].rotation);
             }
-            let new_rot = rotation_arc(anim, sim).mul_quat(animated).normalize();
+            let new_rot = rotation_arc(anim, sim)
+                .mul_quat(Q::<T>::of(animated))
+                .normalize();
             let parent_rot = match r.parent {
                 RotatorParent::Rotator(k2) => turned[k2],
                 RotatorParent::Joint(q) => {
@@ -366,7 +405,12 @@ impl ChainLanes {
                 }
                 RotatorParent::Root => Q::splat(Quat::IDENTITY),
             };
-            let local = parent_rot.conjugate().mul_quat(new_rot).normalize();
+            let local = Q::<T>::of(parent_rot)
+                .conjugate()
+                .mul_quat(new_rot)
+                .normalize()
+                .f();
+            let new_rot = new_rot.f();
             for (l, &j) in r.joints.iter().enumerate().take(count) {
                 if skip.0[l] == 0 {
                     locals[j as usize].rotation = local.get(l);

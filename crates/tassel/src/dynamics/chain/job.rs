@@ -311,7 +311,13 @@ impl ChainJob<'_> {
 
         if lanes {
             for (group, lanes) in rig.lane_groups.iter().zip(&state.lanes) {
-                lanes.write_back(group, locals, models, &mut state.turned);
+                lanes.write_back(
+                    group,
+                    locals,
+                    models,
+                    &mut state.turned,
+                    state.simd == SimdUse::Auto,
+                );
             }
         }
         write_back(
