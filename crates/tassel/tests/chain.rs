@@ -606,3 +606,32 @@ fn a_chain_reset_does_not_change_the_other_chains() {
     let first = with.iter().zip(&without).position(|(a, b)| a != b);
     assert_eq!(first, None, "first differing point (frame × 6 + point)");
 }
+
+/// A chain state made for another rig (other chains, other twins) is refused by name,
+/// not read out of its bounds.
+#[test]
+fn a_state_of_another_rig_is_refused() {
+    let (sk, rig) = tassel::builtin::bench_character(4, 5, 2);
+    let (_, other) = tassel::builtin::bench_character(4, 5, 2);
+    let chains = ChainRig::new(&sk, &rig).unwrap();
+    let fewer = RigSettings {
+        chains: other.chains[..3].to_vec(),
+        ..other
+    };
+    let mut wrong = ChainState::new(&ChainRig::new(&sk, &fewer).unwrap());
+    let mut locals = sk.rest().to_vec();
+    let mut models = locals.clone();
+    let err = ChainJob {
+        skeleton: &sk,
+        rig: &chains,
+        state: &mut wrong,
+        component: Transform::IDENTITY,
+        dt: 1.0 / 60.0,
+        locals: &mut locals,
+        models: &mut models,
+        level: None,
+    }
+    .run()
+    .unwrap_err();
+    assert!(err.to_string().contains("another chain rig"), "{err}");
+}

@@ -564,6 +564,13 @@ impl Twins {
         }
     }
 
+    /// Whether these lanes were made for `count` twins of `rig`'s one chain.
+    pub(super) fn fits(&self, rig: &ChainRig, count: usize) -> bool {
+        self.pack.count == count
+            && self.pack.pos.len() == rig.point_count()
+            && self.scratch.colliders.len() == rig.colliders.len() * LANES
+    }
+
     /// Lane `l` from chain `ci` (points from `start`) of the scalar state `s`.
     pub(super) fn load_lane(
         &mut self,

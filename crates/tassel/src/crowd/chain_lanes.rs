@@ -295,6 +295,11 @@ impl ChainLanes {
         }
     }
 
+    /// Whether these lanes were made for `group`.
+    pub(crate) fn fits(&self, group: &ChainLaneGroup) -> bool {
+        self.twins.fits(&group.rig, group.chains.len())
+    }
+
     /// Takes the group's chains' state from the scalar layout.
     pub(crate) fn load(&mut self, rig: &ChainRig, group: &ChainLaneGroup, s: &mut ScalarChains) {
         for (l, &ci) in group.chains.iter().enumerate() {

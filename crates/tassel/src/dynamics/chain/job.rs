@@ -232,6 +232,22 @@ impl ChainJob<'_> {
         if !(self.dt.is_finite() && self.dt >= 0.0) {
             return Err(Error::InvalidTimeStep(self.dt));
         }
+        // A state made for another rig would be read out of its bounds.
+        let state = &*self.state;
+        let fits = state.pos.len() == self.rig.point_count()
+            && state.accumulator.len() == self.rig.chains.len()
+            && state.colliders.len() == self.rig.colliders.len()
+            && state.lanes.len() == self.rig.lane_groups.len()
+            && state
+                .lanes
+                .iter()
+                .zip(&self.rig.lane_groups)
+                .all(|(l, g)| l.fits(g));
+        if !fits {
+            return Err(Error::InvalidParameter(
+                "chain state was made for another chain rig".into(),
+            ));
+        }
         if !self.component.is_finite() {
             return Err(Error::NonFinite("character transform".into()));
         }
