@@ -24,8 +24,10 @@ use crate::rng::SplitMix64;
 use crate::skeleton::Skeleton;
 use glam::{Quat, Vec3};
 
-/// Fewer twins than this run the scalar step: a lane group costs about as much as
-/// [`LANES`] scalar chains' arithmetic would share, and more in collisions.
+/// A chain without a twin runs the scalar step (a group of one would pay eight lanes'
+/// arithmetic for one chain). Groups of two and more run in lanes; whether two or three
+/// twins gain over the scalar step has not been measured (the bench rig has groups of
+/// eight).
 const MIN_TWINS: usize = 2;
 
 /// Twin chains of a rig, stepped together: lane `l` is `chains[l]`.
@@ -69,39 +71,62 @@ enum RotatorParent {
 
 /// The lane groups of `rig`: chains that do not collide with the world (the lanes have no
 /// level), grouped in rig order with their twins, groups of at least [`MIN_TWINS`].
-pub(crate) fn plan(sk_parent: &[Option<usize>], full: &ChainRig) -> Vec<ChainLaneGroup> {
-    let rig = full;
+pub(crate) fn plan(sk_parent: &[Option<usize>], rig: &ChainRig) -> Vec<ChainLaneGroup> {
     let mut groups: Vec<Vec<usize>> = Vec::new();
+    // Each key's group still open (fewer than LANES chains): one look-up per chain.
+    let mut open: std::collections::HashMap<_, usize> = std::collections::HashMap::new();
     for ci in 0..rig.chains.len() {
         if rig.chains[ci].settings.world_collision {
             continue;
         }
-        match groups
-            .iter_mut()
-            .find(|g| g.len() < LANES && twins(rig, g[0], ci))
-        {
-            Some(g) => g.push(ci),
-            None => groups.push(vec![ci]),
+        let key = twin_key(rig, ci);
+        match open.get(&key).copied() {
+            Some(g) if groups[g].len() < LANES => groups[g].push(ci),
+            _ => {
+                open.insert(key, groups.len());
+                groups.push(vec![ci]);
+            }
         }
     }
+    let tables = RotatorTables::of(sk_parent, rig);
     groups
         .into_iter()
         .filter(|g| g.len() >= MIN_TWINS)
         .map(|chains| {
-            let rig = one_chain(rig, chains[0]);
-            let shapes = rig
+            let one = one_chain(rig, chains[0]);
+            let shapes = one
                 .colliders
                 .iter()
                 .map(|c| LaneShape::of(c.shape))
                 .collect();
             ChainLaneGroup {
-                write_back: lane_rotators(sk_parent, full, &chains),
+                write_back: lane_rotators(sk_parent, rig, &tables, &chains),
                 chains,
-                rig,
+                rig: one,
                 shapes,
             }
         })
         .collect()
+}
+
+/// The rig's rotators by joint and by chain (in joint order).
+struct RotatorTables {
+    of_joint: Vec<Option<usize>>,
+    of_chain: Vec<Vec<usize>>,
+}
+
+impl RotatorTables {
+    fn of(sk_parent: &[Option<usize>], rig: &ChainRig) -> RotatorTables {
+        let mut t = RotatorTables {
+            of_joint: vec![None; sk_parent.len()],
+            of_chain: vec![Vec::new(); rig.chains.len()],
+        };
+        for (r, (j, p, _)) in rig.rotators.iter().enumerate() {
+            t.of_joint[*j as usize] = Some(r);
+            t.of_chain[rig.chain_of[*p as usize] as usize].push(r);
+        }
+        t
+    }
 }
 
 /// The rotators of the twin `chains` lined up by index, or `None` when one's parent joint
@@ -109,22 +134,12 @@ pub(crate) fn plan(sk_parent: &[Option<usize>], full: &ChainRig) -> Vec<ChainLan
 fn lane_rotators(
     sk_parent: &[Option<usize>],
     rig: &ChainRig,
+    tables: &RotatorTables,
     chains: &[usize],
 ) -> Option<Vec<LaneRotator>> {
-    let rotator_of_joint = |j: usize| rig.rotators.iter().position(|r| r.0 as usize == j);
+    let rotator_of_joint = |j: usize| tables.of_joint[j];
     // Each chain's rotators, in joint order.
-    let per_chain: Vec<Vec<usize>> = chains
-        .iter()
-        .map(|&ci| {
-            (0..rig.rotators.len())
-                .filter(|&r| {
-                    rig.chains[ci]
-                        .points
-                        .contains(&(rig.rotators[r].1 as usize))
-                })
-                .collect()
-        })
-        .collect();
+    let per_chain: Vec<&Vec<usize>> = chains.iter().map(|&ci| &tables.of_chain[ci]).collect();
     let count = per_chain[0].len();
     if per_chain.iter().any(|r| r.len() != count) {
         return None;
@@ -177,49 +192,42 @@ fn lane_rotators(
     Some(out)
 }
 
-/// Whether chains `a` and `b` step alike: the same point tree (parents relative to the
-/// chain's first point), the same per-point parameters (bits), the same collider list,
-/// and the same settings but for the names, the curves (already in the per-point
-/// parameters), the dummy bone length (read only where the targets are gathered) and the
-/// wind's seed (each lane has its own generator).
-fn twins(rig: &ChainRig, a: usize, b: usize) -> bool {
-    let (ca, cb) = (&rig.chains[a], &rig.chains[b]);
-    if ca.points.len() != cb.points.len() || ca.colliders != cb.colliders {
-        return false;
-    }
-    let rebase = |p: u32, start: usize| {
-        if p == NONE {
+/// What decides whether two chains step alike (twins have equal keys): the point tree
+/// (parents relative to the chain's first point), the per-point parameters (bits), the
+/// collider list, and the settings but for the names, the curves (already in the
+/// per-point parameters), the dummy bone length (read only where the targets are
+/// gathered) and the wind's seed (each lane has its own generator). The settings as
+/// their `Debug` text: validated finite, so equal text is equal values (an `f32` prints
+/// the shortest text that reads back to its bits; -0 and 0 print apart).
+fn twin_key(rig: &ChainRig, ci: usize) -> (Vec<u32>, Vec<usize>, String) {
+    let c = &rig.chains[ci];
+    let mut points = Vec::with_capacity(c.points.len() * 7);
+    for p in c.points.clone() {
+        let parent = rig.parent[p];
+        points.push(if parent == NONE {
             NONE
         } else {
-            p - start as u32
+            parent - c.points.start as u32
+        });
+        for v in [
+            &rig.damping,
+            &rig.stiffness,
+            &rig.radius,
+            &rig.wd_location,
+            &rig.wd_rotation,
+            &rig.limit_angle,
+        ] {
+            points.push(v[p].to_bits());
         }
-    };
-    let same_points = ca.points.clone().zip(cb.points.clone()).all(|(p, q)| {
-        let bits = |v: &[f32]| (v[p].to_bits(), v[q].to_bits());
-        let same = |v: &[f32]| {
-            let (x, y) = bits(v);
-            x == y
-        };
-        rebase(rig.parent[p], ca.points.start) == rebase(rig.parent[q], cb.points.start)
-            && same(&rig.damping)
-            && same(&rig.stiffness)
-            && same(&rig.radius)
-            && same(&rig.wd_location)
-            && same(&rig.wd_rotation)
-            && same(&rig.limit_angle)
-    });
-    if !same_points {
-        return false;
     }
-    let mut s = cb.settings.clone();
-    let r = &ca.settings;
-    s.name.clone_from(&r.name);
-    s.root.clone_from(&r.root);
-    s.exclude.clone_from(&r.exclude);
-    s.curves.clone_from(&r.curves);
-    s.dummy_bone_length = r.dummy_bone_length;
-    s.wind.seed = r.wind.seed;
-    s == *r
+    let mut settings = c.settings.clone();
+    settings.name.clear();
+    settings.root.clear();
+    settings.exclude.clear();
+    settings.curves = Default::default();
+    settings.dummy_bone_length = 0.0;
+    settings.wind.seed = 0;
+    (points, c.colliders.clone(), format!("{settings:?}"))
 }
 
 /// Chain `ci` of `rig` as a rig of one chain, its points from 0.
