@@ -265,6 +265,7 @@ fn one_chain(rig: &ChainRig, ci: usize) -> ChainRig {
         rotator_children: Vec::new(),
         lane_groups: Vec::new(),
         rotator_in_lanes: Vec::new(),
+        chain_in_lanes: Vec::new(),
         joint_count: rig.joint_count(),
     }
 }

@@ -54,6 +54,8 @@ pub struct ChainRig {
     pub(crate) lane_groups: Vec<crate::crowd::chain_lanes::ChainLaneGroup>,
     /// Per rotator: written back in a lane group's lanes (with the lanes on).
     pub(crate) rotator_in_lanes: Vec<bool>,
+    /// Per chain: stepped in a lane group (with the lanes on).
+    pub(crate) chain_in_lanes: Vec<bool>,
     pub(crate) joint_count: usize,
 }
 
@@ -81,6 +83,7 @@ impl ChainRig {
             rotator_children: Vec::new(),
             lane_groups: Vec::new(),
             rotator_in_lanes: Vec::new(),
+            chain_in_lanes: Vec::new(),
             joint_count: skeleton.len(),
         };
         out.colliders = CompiledCollider::compile_all(skeleton, rig);
@@ -221,17 +224,22 @@ impl ChainRig {
         }
         let parents: Vec<Option<usize>> = (0..skeleton.len()).map(|j| skeleton.parent(j)).collect();
         out.lane_groups = crate::crowd::chain_lanes::plan(&parents, &out);
-        out.rotator_in_lanes = vec![false; out.rotators.len()];
+        out.chain_in_lanes = vec![false; out.chains.len()];
+        for &ci in out.lane_groups.iter().flat_map(|g| &g.chains) {
+            out.chain_in_lanes[ci] = true;
+        }
+        // A rotator is written back in lanes when its chain's group does that.
+        let mut lane_write_back = vec![false; out.chains.len()];
         for g in out.lane_groups.iter().filter(|g| g.write_back.is_some()) {
-            for (r, (_, p, _)) in out.rotators.iter().enumerate() {
-                if g.chains
-                    .iter()
-                    .any(|&ci| out.chains[ci].points.contains(&(*p as usize)))
-                {
-                    out.rotator_in_lanes[r] = true;
-                }
+            for &ci in &g.chains {
+                lane_write_back[ci] = true;
             }
         }
+        out.rotator_in_lanes = out
+            .rotators
+            .iter()
+            .map(|(_, p, _)| lane_write_back[out.chain_of[*p as usize] as usize])
+            .collect();
         Ok(out)
     }
 
@@ -316,7 +324,7 @@ impl ChainRig {
 
     /// Whether chain `ci` is stepped in a lane group.
     pub(crate) fn in_lane_group(&self, ci: usize) -> bool {
-        self.lane_groups.iter().any(|g| g.chains.contains(&ci))
+        self.chain_in_lanes.get(ci).copied().unwrap_or(false)
     }
 
     /// The colliders chain `i` collides with.
