@@ -118,6 +118,18 @@ impl Lane for Fa {
         self.abs().lt(Fa::splat(f32::INFINITY))
     }
     #[inline(always)]
+    fn bits_eq(self, o: Fa) -> Ma {
+        // SAFETY: see the module's documentation (`_mm256_cmpeq_epi32` is AVX2, which the
+        // functions that use `Fa` enable). The casts only reinterpret the bits; equal
+        // 32-bit integers are equal `f32::to_bits`.
+        Ma(unsafe {
+            _mm256_castsi256_ps(_mm256_cmpeq_epi32(
+                _mm256_castps_si256(self.0),
+                _mm256_castps_si256(o.0),
+            ))
+        })
+    }
+    #[inline(always)]
     fn select(m: Ma, a: Fa, b: Fa) -> Fa {
         // SAFETY: see the module's documentation. `m` is all ones or all zeros per lane,
         // so the sign-bit blend picks whole lanes, as `F::select`'s bitwise choice.
@@ -238,6 +250,12 @@ mod tests {
                 assert_eq!(Lane::gt(x, y).m(), a.gt(b), "{a:?} > {b:?}");
                 assert_eq!(Lane::ne(x, y).m(), a.ne(b), "{a:?} != {b:?}");
                 assert_eq!(Lane::finite(x).m(), a.finite(), "finite {a:?}");
+                assert_eq!(
+                    Lane::bits_eq(x, y).m(),
+                    Lane::bits_eq(a, b),
+                    "{a:?} bits {b:?}"
+                );
+                assert_eq!(Lane::bits_eq(x, x).m(), M::ALL, "{a:?} bits itself");
                 let m = a.lt(b);
                 let (mx, ma) = (Ma::of(m), m);
                 assert!(same(Fa::select(mx, x, y).f(), F::select(ma, a, b)));

@@ -12,7 +12,7 @@ use super::lanes::{
     closest_params_segment_segment, closest_point_on_segment, differs, Lane, Mask, F, LANES, M, Q,
     V3,
 };
-use crate::collide::{entry_radius, PlacedCollider, Shape};
+use crate::collide::{PlacedCollider, Shape};
 use crate::dynamics::chain::compile::{ChainRig, NONE};
 use crate::dynamics::chain::step::{cone_limit, pull};
 use crate::dynamics::chain::PlanarAxis;
@@ -108,19 +108,25 @@ impl LaneShape {
 /// scalar narrow phase: rarer, and with a root finding of its own), and for the lanes it
 /// may move without an entry, the point it gives back (pushed out to the surface).
 #[derive(Clone, Copy)]
-struct LaneContact<T: Lane> {
-    may: T::M,
-    entered: T::M,
-    pushed: V3<T>,
+pub(super) struct LaneContact<T: Lane> {
+    pub may: T::M,
+    pub entered: T::M,
+    pub pushed: V3<T>,
 }
 
 /// [`crate::collide::push_out_of_sphere`] per lane, as far as it goes without an entry:
 /// the step entered the entry surface from outside it (`entered`), or `p` lies inside
 /// `limit` and is pushed out along the shortest way (`pushed`, with the function's
-/// fallback direction).
+/// fallback direction). `limit` per lane.
 #[inline(always)]
-fn sphere_contact<T: Lane>(p: V3<T>, prev: V3<T>, center: V3<T>, limit: f32) -> LaneContact<T> {
-    let inner2 = T::splat(entry_radius(limit).powi(2));
+pub(super) fn sphere_contact<T: Lane>(
+    p: V3<T>,
+    prev: V3<T>,
+    center: V3<T>,
+    limit: T,
+) -> LaneContact<T> {
+    let inner = entry_radius_lanes(limit);
+    let inner2 = inner * inner;
     let from = prev - center;
     let prev_out = inner2.le(from.dot(from));
     let c = closest_point_on_segment(center, prev, p) - center;
@@ -129,26 +135,33 @@ fn sphere_contact<T: Lane>(p: V3<T>, prev: V3<T>, center: V3<T>, limit: f32) -> 
     // `outside_sphere(p, center, limit, normalize_or(prev - center, Y))` where it pushes.
     let fallback = from.normalize_or(V3::splat(Vec3::Y));
     LaneContact {
-        may: entered.or(d.dot(d).lt(T::splat(limit * limit))),
+        may: entered.or(d.dot(d).lt(limit * limit)),
         entered,
-        pushed: center + d.normalize_or(fallback) * T::splat(limit),
+        pushed: center + d.normalize_or(fallback) * limit,
     }
+}
+
+/// [`crate::collide::entry_radius`] per lane: `limit` less the contact tolerance (1e-4 of it), never
+/// below 0, with the scalar function's operations.
+#[inline(always)]
+fn entry_radius_lanes<T: Lane>(limit: T) -> T {
+    (limit - T::splat(1e-4) * limit).max(T::splat(0.0))
 }
 
 /// [`crate::collide::push_out_of_capsule`] (capsule `a`–`b`) per lane, as far as it goes
 /// without an entry: the step started at or beyond the entry surface and its closest
 /// approach to the axis is inside it (`entered`), or `p` lies inside `limit` and is pushed
 /// out to the nearest point of the surface (`pushed`, with the function's fallback
-/// direction, from the step's start).
+/// direction, from the step's start). `limit` per lane.
 #[inline(always)]
-fn capsule_contact<T: Lane>(
+pub(super) fn capsule_contact<T: Lane>(
     p: V3<T>,
     prev: V3<T>,
     a: V3<T>,
     b: V3<T>,
-    limit: f32,
+    limit: T,
 ) -> LaneContact<T> {
-    let inner = T::splat(entry_radius(limit));
+    let inner = entry_radius_lanes(limit);
     let from_axis = prev - closest_point_on_segment(prev, a, b);
     let prev_dist = from_axis.length();
     let (s, t) = closest_params_segment_segment(prev, p, a, b);
@@ -161,9 +174,9 @@ fn capsule_contact<T: Lane>(
     // `outside_capsule(p, a, b, limit, prev_fallback())` where it pushes.
     let fallback = from_axis.normalize_or((b - a).any_orthonormal());
     LaneContact {
-        may: entered.or(d.dot(d).lt(T::splat(limit * limit))),
+        may: entered.or(d.dot(d).lt(limit * limit)),
         entered,
-        pushed: c + d.normalize_or(fallback) * T::splat(limit),
+        pushed: c + d.normalize_or(fallback) * limit,
     }
 }
 
@@ -195,7 +208,7 @@ pub(super) struct LaneStep<'a> {
 
 /// glam's `Vec3::min` per lane (`a < b ? a : b`, glam's NaN rule).
 #[inline(always)]
-fn vmin<T: Lane>(a: V3<T>, b: V3<T>) -> V3<T> {
+pub(super) fn vmin<T: Lane>(a: V3<T>, b: V3<T>) -> V3<T> {
     V3 {
         x: T::select(a.x.lt(b.x), a.x, b.x),
         y: T::select(a.y.lt(b.y), a.y, b.y),
@@ -205,7 +218,7 @@ fn vmin<T: Lane>(a: V3<T>, b: V3<T>) -> V3<T> {
 
 /// glam's `Vec3::max` per lane (`a > b ? a : b`).
 #[inline(always)]
-fn vmax<T: Lane>(a: V3<T>, b: V3<T>) -> V3<T> {
+pub(super) fn vmax<T: Lane>(a: V3<T>, b: V3<T>) -> V3<T> {
     V3 {
         x: T::select(a.x.gt(b.x), a.x, b.x),
         y: T::select(a.y.gt(b.y), a.y, b.y),
@@ -312,10 +325,10 @@ fn collide<T: Lane>(
         // their point from the lanes' own narrow phase; the rest (entries, other shapes)
         // from the scalar one.
         let contact = match shape.decision {
-            Decision::Sphere(radius) => Some(sphere_contact(y, q, bc, radius + r)),
+            Decision::Sphere(radius) => Some(sphere_contact(y, q, bc, T::splat(radius + r))),
             Decision::Capsule(radius) => {
                 let (a, b) = (V3::of(bound.a), V3::of(bound.b));
-                Some(capsule_contact(y, q, a, b, radius + r))
+                Some(capsule_contact(y, q, a, b, T::splat(radius + r)))
             }
             Decision::Scalar => None,
         };
@@ -612,9 +625,9 @@ mod tests {
                 c.set(l, centre);
             }
             let contact = if capsule {
-                capsule_contact(p, q, a, b, limit)
+                capsule_contact(p, q, a, b, F::splat(limit))
             } else {
-                sphere_contact(p, q, c, limit)
+                sphere_contact(p, q, c, F::splat(limit))
             };
             let (may, entered, pushed) = (contact.may, contact.entered, contact.pushed);
             #[cfg(target_arch = "x86_64")]
@@ -666,9 +679,9 @@ mod tests {
         use crate::crowd::avx::Fa;
         let (p, q) = (V3::<Fa>::of(p), V3::<Fa>::of(q));
         let k = if capsule {
-            capsule_contact(p, q, V3::of(a), V3::of(b), limit)
+            capsule_contact(p, q, V3::of(a), V3::of(b), Fa::splat(limit))
         } else {
-            sphere_contact(p, q, V3::of(c), limit)
+            sphere_contact(p, q, V3::of(c), Fa::splat(limit))
         };
         (k.may.m(), k.entered.m(), k.pushed.f())
     }

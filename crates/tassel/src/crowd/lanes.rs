@@ -267,6 +267,19 @@ pub trait Lane:
     fn signum(self) -> Self {
         Self::of(F(self.f().0.map(f32::signum)))
     }
+    /// Whether the lanes hold the same bits (unlike `==`: `-0` and `0` differ, a NaN
+    /// matches its own bits), as `f32::to_bits` compared.
+    #[inline(always)]
+    fn bits_eq(self, o: Self) -> Self::M {
+        let (a, b) = (self.f(), o.f());
+        Self::M::of(M(std::array::from_fn(|i| {
+            if a.0[i].to_bits() == b.0[i].to_bits() {
+                !0
+            } else {
+                0
+            }
+        })))
+    }
     /// Lane `i`.
     #[inline(always)]
     fn get(self, i: usize) -> f32 {
@@ -546,6 +559,15 @@ impl<T: Lane> V3<T> {
             y: T::select(m, a.y, b.y),
             z: T::select(m, a.z, b.z),
         }
+    }
+
+    /// The same bits in every component, per lane ([`Lane::bits_eq`]).
+    #[inline(always)]
+    pub fn bits_eq(self, o: V3<T>) -> T::M {
+        self.x
+            .bits_eq(o.x)
+            .and(self.y.bits_eq(o.y))
+            .and(self.z.bits_eq(o.z))
     }
 
     /// Finite in every component, per lane.

@@ -15,6 +15,7 @@ mod avx;
 mod chain;
 pub(crate) mod chain_lanes;
 mod chain_step;
+pub(crate) mod cloth_lanes;
 pub mod lanes;
 pub(crate) mod spring_lanes;
 mod vrm;

@@ -49,6 +49,12 @@ pub(crate) struct CompiledCloth {
     /// Quads `[p00, p10, p11, p01]` (chain i at k, chain i+1 at k, … at k+1).
     pub quads: Vec<[u32; 4]>,
     pub colliders: Vec<usize>,
+    /// The structural constraints (global indices), in order: the segments the segment
+    /// collision keeps out of the colliders.
+    pub structural: Vec<u32>,
+    /// The quads' triangles in the order the surface collision takes them: per quad
+    /// `[p00, p10, p11]` then `[p00, p11, p01]`.
+    pub triangles: Vec<[u32; 3]>,
 }
 
 /// Every `[[cloth]]` of a rig compiled for one skeleton. Immutable: share it between the
@@ -284,6 +290,19 @@ impl ClothRig {
                 }
             }
             let colliders = rig.collider_indices(&s.colliders);
+            let structural = (cstart..out.constraints.len())
+                .filter(|&i| {
+                    matches!(
+                        out.constraints[i].kind,
+                        ConstraintKind::StructuralVertical | ConstraintKind::StructuralHorizontal
+                    )
+                })
+                .map(|i| i as u32)
+                .collect();
+            let triangles = quads
+                .iter()
+                .flat_map(|&[q00, q10, q11, q01]| [[q00, q10, q11], [q00, q11, q01]])
+                .collect();
             out.cloths.push(CompiledCloth {
                 settings: s.clone(),
                 points: first..out.joint.len(),
@@ -291,6 +310,8 @@ impl ClothRig {
                 constraints: cstart..out.constraints.len(),
                 quads,
                 colliders,
+                structural,
+                triangles,
             });
         }
         Ok(out)

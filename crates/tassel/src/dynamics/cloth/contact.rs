@@ -85,9 +85,9 @@ pub(crate) fn push_segment(
 /// usually leave them), so that each further collider only pays for its own test.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct TriangleFrame {
-    normal: Vec3,
-    centroid: Vec3,
-    bound: f32,
+    pub normal: Vec3,
+    pub centroid: Vec3,
+    pub bound: f32,
 }
 
 impl TriangleFrame {
@@ -193,7 +193,23 @@ pub(crate) fn push_triangle(
 /// `!=`, collider by collider). The triangle's frame is made once, and again only after
 /// a collider moved a corner: the result is that of a frame made afresh per collider.
 pub(crate) fn push_triangle_against(
+    corners: [Vec3; 3],
+    free: [bool; 3],
+    r: f32,
+    cores: &[Option<Core>],
+    mode: SurfaceCollision,
+    sides: &mut [i8],
+) -> ([Vec3; 3], bool) {
+    let frame = TriangleFrame::of(corners[0], corners[1], corners[2]);
+    push_triangle_against_from(corners, frame, free, r, cores, mode, sides)
+}
+
+/// [`push_triangle_against`] with the triangle's frame already made: `frame` must be
+/// [`TriangleFrame::of`] the `corners` (the cloth's lanes make it for several triangles
+/// at once, with the same operations).
+pub(crate) fn push_triangle_against_from(
     mut corners: [Vec3; 3],
+    mut frame: Option<TriangleFrame>,
     free: [bool; 3],
     r: f32,
     cores: &[Option<Core>],
@@ -201,7 +217,6 @@ pub(crate) fn push_triangle_against(
     sides: &mut [i8],
 ) -> ([Vec3; 3], bool) {
     let mut touched = false;
-    let mut frame = TriangleFrame::of(corners[0], corners[1], corners[2]);
     for (core, side) in cores.iter().zip(sides) {
         let Some(core) = core else { continue };
         // A degenerate triangle is left alone by every collider, so it stays degenerate.
@@ -226,7 +241,7 @@ pub(crate) fn push_triangle_against(
 }
 
 /// Whether two vectors are the same bits (unlike `==`, which takes −0 for 0).
-fn same_bits(a: Vec3, b: Vec3) -> bool {
+pub(crate) fn same_bits(a: Vec3, b: Vec3) -> bool {
     a.to_array().map(f32::to_bits) == b.to_array().map(f32::to_bits)
 }
 

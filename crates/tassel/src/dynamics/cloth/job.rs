@@ -4,6 +4,8 @@ use super::compile::{ClothRig, ConstraintKind};
 use super::contact::{push_segment, push_triangle_against, Core};
 use crate::collide::PlacedCollider;
 use crate::controller::Level;
+use crate::crowd::cloth_lanes::{self, ClothLaneScratch};
+use crate::crowd::SimdUse;
 use crate::dynamics::path::CharacterPath;
 use crate::dynamics::world::collide_points;
 use crate::error::{Error, Result};
@@ -44,6 +46,10 @@ pub struct ClothState {
     /// Scratch: each of a cloth's colliders as a core segment, slot by slot, for one
     /// `collide` call.
     cores: Vec<Option<Core>>,
+    /// Which code runs the contact tests (every choice gives the same bits).
+    simd: SimdUse,
+    /// Scratch of the contact tests' lanes.
+    lanes: ClothLaneScratch,
 }
 
 impl ClothState {
@@ -88,7 +94,21 @@ impl ClothState {
             needs_reset: vec![true; rig.cloths.len()],
             resets: 0,
             cores: Vec::new(),
+            simd: SimdUse::default(),
+            lanes: ClothLaneScratch::default(),
         }
+    }
+
+    /// Which code runs the contact tests (points, segments and quads against the
+    /// colliders): lanes by default ([`SimdUse::Auto`]), [`SimdUse::Scalar`] for the
+    /// readable reference. Every choice gives the same bits.
+    pub fn set_simd(&mut self, simd: SimdUse) {
+        self.simd = simd;
+    }
+
+    /// The code chosen by [`ClothState::set_simd`].
+    pub fn simd(&self) -> SimdUse {
+        self.simd
     }
 
     /// Makes the next frame start again from the animated pose.
@@ -328,7 +348,8 @@ fn run_cloth(
         limit_lengths(rig, ci, &mut state.out_world, None);
     }
     for _ in 0..3 {
-        let mut touched = collide(
+        let mut touched = collide_with(
+            state.simd,
             rig,
             ci,
             &state.colliders,
@@ -336,7 +357,7 @@ fn run_cloth(
             None,
             None,
             false,
-            &mut state.cores,
+            (&mut state.cores, &mut state.lanes),
         );
         if let Some(level) = level {
             let (free, radius) = (|p: usize| !rig.fixed[p], |p: usize| rig.radius[p]);
@@ -429,9 +450,12 @@ fn step(rig: &ClothRig, ci: usize, state: &mut ClothState, h: f32, level: Option
             sides,
             friction,
             cores,
+            simd,
+            lanes,
             ..
         } = &mut *state;
-        collide(
+        collide_with(
+            *simd,
             rig,
             ci,
             step_colliders,
@@ -440,7 +464,7 @@ fn step(rig: &ClothRig, ci: usize, state: &mut ClothState, h: f32, level: Option
             Some((friction, &mut sides[ci])),
             // Quads (the costly test) once per step, in the last iteration.
             it + 1 == s.iterations,
-            cores,
+            (cores, lanes),
         );
     }
     if s.limit_angle > 0.0 {
@@ -469,6 +493,37 @@ fn step(rig: &ClothRig, ci: usize, state: &mut ClothState, h: f32, level: Option
             |p| rig.radius[p],
             |p, _| friction[p] = friction[p].max(rig.friction[p]),
         );
+    }
+}
+
+/// [`collide`] by the code `simd` chooses: the scalar reference itself, or the same
+/// tests in lanes (`crowd/cloth_lanes.rs`), which give its bits.
+#[allow(clippy::too_many_arguments)]
+fn collide_with(
+    simd: SimdUse,
+    rig: &ClothRig,
+    ci: usize,
+    colliders: &[PlacedCollider],
+    pos: &mut [Vec3],
+    prev: Option<&[Vec3]>,
+    contact: Option<(&mut [f32], &mut [i8])>,
+    surfaces: bool,
+    (cores, lanes): (&mut Vec<Option<Core>>, &mut ClothLaneScratch),
+) -> bool {
+    match simd {
+        SimdUse::Scalar => collide(rig, ci, colliders, pos, prev, contact, surfaces, cores),
+        SimdUse::Portable | SimdUse::Auto => cloth_lanes::collide(
+            simd == SimdUse::Auto,
+            rig,
+            ci,
+            colliders,
+            pos,
+            prev,
+            contact,
+            surfaces,
+            cores,
+            lanes,
+        ),
     }
 }
 

@@ -9,8 +9,8 @@
 //! the per-character state; [`ClothJob`] runs one frame. The simulation runs in world
 //! space, so the character's own motion moves the cloth by inertia.
 
-mod compile;
-mod contact;
+pub(crate) mod compile;
+pub(crate) mod contact;
 mod job;
 mod settings;
 

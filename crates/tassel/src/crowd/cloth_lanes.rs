@@ -1,0 +1,575 @@
+//! One character's bone cloth with its contact tests in SIMD lanes: the cloth job's
+//! `collide` (points, structural segments and quad triangles against the cloth's
+//! colliders), giving the scalar function's bits.
+//!
+//! - **Points**: for one collider, every point's answer depends on that point alone, so
+//!   [`LANES`] points are tested side by side: the collider's quick rejection and, for
+//!   keep-out spheres and capsules, the narrow phase's contact decision and push out
+//!   (the chain lanes' own, `chain_step.rs`); a step that *entered* a shape, and every
+//!   other shape, goes to the scalar collider for the lanes that need it.
+//! - **Segments and triangles** are tested in order, and a push moves points that later
+//!   segments and triangles share, so the lanes *look ahead*: before the pass they test
+//!   every segment's quick rejection, and every triangle's whole contact decision (its
+//!   frame, the cheap reject, the closest points by alternating projections, the side
+//!   memory), from the points as they are. Then the pass walks in the scalar order: a
+//!   segment or triangle none of whose points an earlier push in the pass moved takes the
+//!   lanes' answer (the same bits: the same operations on the same inputs); one that
+//!   would be pushed, or whose points moved, is done by the scalar code from there on.
+//!   Where nothing touches (most of the time), nothing is left to the scalar code.
+
+use super::chain_step::{capsule_contact, sphere_contact, vmax, vmin};
+use super::lanes::{closest_point_on_segment, differs, Lane, Mask, F, LANES, M, V3};
+use crate::collide::{PlacedCollider, Shape};
+use crate::dynamics::cloth::compile::ClothRig;
+use crate::dynamics::cloth::contact::{
+    push_segment, push_triangle_against, push_triangle_against_from, same_bits, Core, TriangleFrame,
+};
+use crate::dynamics::cloth::SurfaceCollision;
+use glam::Vec3;
+
+#[cfg(target_arch = "x86_64")]
+use super::avx::Fa;
+
+/// What one contact pass keeps between its look-ahead and its walk. Lives in the cloth
+/// state; sized on first use, so a frame allocates nothing.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct ClothLaneScratch {
+    /// Per point: moved by a push earlier in this pass.
+    dirty: Vec<bool>,
+    /// Per structural segment: bit `j` set when core slot `j` rejects it.
+    far: Vec<u64>,
+    /// Per triangle: its frame (`None`: degenerate).
+    frames: Vec<Option<TriangleFrame>>,
+    /// Per triangle and core slot: the side memory after the pair's test where it pushes
+    /// nothing (±1), or 0 where the scalar code must do it (it pushes, or no answer).
+    sides: Vec<i8>,
+}
+
+/// The cloth job's `collide`, computed with lanes: AVX2 where `avx2` allows it and the
+/// CPU has it, else the portable lane type. The same arguments and results, bit for bit.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn collide(
+    avx2: bool,
+    rig: &ClothRig,
+    ci: usize,
+    colliders: &[PlacedCollider],
+    pos: &mut [Vec3],
+    prev: Option<&[Vec3]>,
+    contact: Option<(&mut [f32], &mut [i8])>,
+    surfaces: bool,
+    cores: &mut Vec<Option<Core>>,
+    scratch: &mut ClothLaneScratch,
+) -> bool {
+    let mut pass = Pass {
+        rig,
+        ci,
+        colliders,
+        pos,
+        prev,
+        contact,
+        surfaces,
+        cores,
+        scratch,
+    };
+    #[cfg(target_arch = "x86_64")]
+    if avx2 && std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: `run_avx2` only requires the AVX2 instructions, and the CPU was just
+        // checked to have them.
+        #[allow(unsafe_code)]
+        unsafe {
+            return pass.run_avx2();
+        }
+    }
+    let _ = avx2;
+    pass.run::<F>()
+}
+
+/// One `collide` call's inputs.
+struct Pass<'a> {
+    rig: &'a ClothRig,
+    ci: usize,
+    colliders: &'a [PlacedCollider],
+    pos: &'a mut [Vec3],
+    prev: Option<&'a [Vec3]>,
+    contact: Option<(&'a mut [f32], &'a mut [i8])>,
+    surfaces: bool,
+    cores: &'a mut Vec<Option<Core>>,
+    scratch: &'a mut ClothLaneScratch,
+}
+
+impl Pass<'_> {
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn run_avx2(&mut self) -> bool {
+        // The explicit AVX lane type, only here after the CPU was found to have AVX2.
+        self.run::<Fa>()
+    }
+
+    /// The scalar `collide`'s passes in its order: points, segments, triangles.
+    #[inline(always)]
+    fn run<T: Lane>(&mut self) -> bool {
+        let (rig, colliders) = (self.rig, self.colliders);
+        let cloth = &rig.cloths[self.ci];
+        let mut touched = false;
+        for &k in &cloth.colliders {
+            touched |= self.points::<T>(&colliders[k]);
+        }
+        self.cores.clear();
+        self.cores
+            .extend(cloth.colliders.iter().map(|&k| Core::of(&colliders[k])));
+        let n = rig.point_count();
+        self.scratch.dirty.resize(n, false);
+        if cloth.settings.segment_collision {
+            touched |= self.segments::<T>();
+        }
+        let mode = cloth.settings.surface_collision;
+        // With the surface test off, every triangle leaves everything as it is.
+        if self.surfaces && self.contact.is_some() && mode != SurfaceCollision::Off {
+            touched |= self.triangles::<T>(mode);
+        }
+        touched
+    }
+
+    /// Every free point against `col`, [`LANES`] at a time, as
+    /// [`PlacedCollider::resolve`]; a moved point is written back (and gets the cloth's
+    /// friction with `contact`). Returns whether any moved.
+    #[inline(always)]
+    fn points<T: Lane>(&mut self, col: &PlacedCollider) -> bool {
+        let rig = self.rig;
+        let points = rig.cloths[self.ci].points.clone();
+        let centre = V3::<T>::splat(col.transform.translation);
+        let bound = col.bounding_radius();
+        let (ends, decision) = match col.shape {
+            Shape::Sphere {
+                radius,
+                inside: false,
+            } => (None, Some(radius)),
+            Shape::Capsule { radius, length } => (Some(col.capsule_ends(length)), Some(radius)),
+            _ => (None, None),
+        };
+        let mut touched = false;
+        let mut start = points.start;
+        while start < points.end {
+            let n = (points.end - start).min(LANES);
+            let (mut x, mut q, mut r, mut active) = (V3::ZERO, V3::ZERO, F([0.0; LANES]), M::NONE);
+            for l in 0..n {
+                let p = start + l;
+                if rig.fixed[p] {
+                    continue;
+                }
+                active.0[l] = !0;
+                x.set(l, self.pos[p]);
+                q.set(l, self.prev.map_or(self.pos[p], |pr| pr[p]));
+                r.0[l] = rig.radius[p];
+            }
+            let (x, q, r) = (V3::<T>::of(x), V3::<T>::of(q), T::of(r));
+            let mut ask = <T::M as Mask>::of(active);
+            // `resolve`'s quick rejection: both ends of the step beyond the shape's
+            // bounding sphere and the step too short to reach it.
+            if let Some(bound) = bound {
+                let reach = T::splat(bound) + r;
+                let reach2 = reach * reach;
+                let (dp, dq, step) = (x - centre, q - centre, x - q);
+                let gap = dp.length() - reach;
+                let rejected = dp
+                    .dot(dp)
+                    .gt(reach2)
+                    .and(dq.dot(dq).gt(reach2))
+                    .and(step.dot(step).lt(gap * gap));
+                ask = ask.and(rejected.not());
+            }
+            if ask.any() {
+                let mut y = x;
+                if let Some(radius) = decision {
+                    let limit = T::splat(radius) + r;
+                    let c = match ends {
+                        Some((a, b)) => capsule_contact(x, q, V3::splat(a), V3::splat(b), limit),
+                        None => sphere_contact(x, q, centre, limit),
+                    };
+                    ask = ask.and(c.may);
+                    y = V3::select(ask.and(c.entered.not()), c.pushed, y);
+                    ask = ask.and(c.entered);
+                }
+                // The scalar collider for what the lanes leave: entries, other shapes.
+                let (ask, mut yf) = (ask.m(), y.f());
+                for l in 0..n {
+                    if ask.0[l] != 0 {
+                        let p = start + l;
+                        let from = self.prev.map_or(self.pos[p], |pr| pr[p]);
+                        yf.set(l, col.resolve(self.pos[p], from, rig.radius[p]));
+                    }
+                }
+                // Written back where it differs by value, as the scalar `after != before`.
+                let moved = differs(V3::<T>::of(yf), x).and(<T::M as Mask>::of(active));
+                if moved.any() {
+                    let moved = moved.m();
+                    for l in 0..n {
+                        if moved.0[l] != 0 {
+                            let p = start + l;
+                            self.pos[p] = yf.get(l);
+                            touched = true;
+                            if let Some((friction, _)) = self.contact.as_mut() {
+                                friction[p] = rig.friction[p];
+                            }
+                        }
+                    }
+                }
+            }
+            start += n;
+        }
+        touched
+    }
+
+    /// The structural segments against the cores, in order (as the scalar pass), with
+    /// the quick rejections looked ahead in lanes.
+    #[inline(always)]
+    fn segments<T: Lane>(&mut self) -> bool {
+        let rig = self.rig;
+        let cloth = &rig.cloths[self.ci];
+        let cores = &self.cores[..];
+        let scratch = &mut *self.scratch;
+        scratch.far.clear();
+        for chunk in cloth.structural.chunks(LANES) {
+            let (mut a, mut b, mut r) = (V3::ZERO, V3::ZERO, F([0.0; LANES]));
+            for (l, &c) in chunk.iter().enumerate() {
+                let c = &rig.constraints[c as usize];
+                let (i, j) = (c.a as usize, c.b as usize);
+                a.set(l, self.pos[i]);
+                b.set(l, self.pos[j]);
+                r.0[l] = 0.5 * (rig.radius[i] + rig.radius[j]);
+            }
+            let (a, b, r) = (V3::<T>::of(a), V3::<T>::of(b), T::of(r));
+            let (lo, hi) = (vmin(a, b), vmax(a, b));
+            let mut far = [0u64; LANES];
+            for (slot, core) in cores.iter().enumerate().take(64) {
+                let Some(core) = core else { continue };
+                let reach = T::splat(core.radius) + r + T::splat(1e-4);
+                let gap = vmax(lo - V3::splat(core.hi), V3::splat(core.lo) - hi);
+                let is_far = max_element(gap).gt(reach).m();
+                for (l, f) in far.iter_mut().enumerate() {
+                    *f |= u64::from(is_far.0[l] != 0) << slot;
+                }
+            }
+            scratch.far.extend_from_slice(&far[..chunk.len()]);
+        }
+        let points = cloth.points.clone();
+        scratch.dirty[points].iter_mut().for_each(|d| *d = false);
+        let mut touched = false;
+        for (i, &c) in cloth.structural.iter().enumerate() {
+            let c = &rig.constraints[c as usize];
+            let (a, b) = (c.a as usize, c.b as usize);
+            // The lanes' rejections hold while neither end has moved in this pass.
+            let far = if scratch.dirty[a] || scratch.dirty[b] {
+                0
+            } else {
+                scratch.far[i]
+            };
+            let r = 0.5 * (rig.radius[a] + rig.radius[b]);
+            let (lo, hi) = (self.pos[a].min(self.pos[b]), self.pos[a].max(self.pos[b]));
+            for (slot, core) in cores.iter().enumerate() {
+                let Some(core) = core else { continue };
+                if slot < 64 && far & (1 << slot) != 0 {
+                    continue;
+                }
+                // The scalar pass's own quick rejection and push.
+                let reach = core.radius + r + 1e-4;
+                let gap = (lo - core.hi).max(core.lo - hi);
+                if gap.max_element() > reach {
+                    continue;
+                }
+                let (mut pa, mut pb) = (self.pos[a], self.pos[b]);
+                if push_segment(
+                    &mut pa,
+                    &mut pb,
+                    [!rig.fixed[a], !rig.fixed[b]],
+                    (core.e0, core.e1, core.radius + r),
+                ) {
+                    self.pos[a] = pa;
+                    self.pos[b] = pb;
+                    scratch.dirty[a] = true;
+                    scratch.dirty[b] = true;
+                    touched = true;
+                }
+            }
+        }
+        touched
+    }
+
+    /// The quads' triangles against the cores, in order (as the scalar pass), with each
+    /// pair's whole decision looked ahead in lanes.
+    #[inline(always)]
+    fn triangles<T: Lane>(&mut self, mode: SurfaceCollision) -> bool {
+        let rig = self.rig;
+        let cloth = &rig.cloths[self.ci];
+        let cores = &self.cores[..];
+        let m = cores.len();
+        let Some((_, sides)) = self.contact.as_mut() else {
+            return false;
+        };
+        let scratch = &mut *self.scratch;
+        let tris = &cloth.triangles;
+        scratch.frames.clear();
+        scratch.sides.clear();
+        scratch.sides.resize(tris.len() * m, 0);
+        let push_pull = mode == SurfaceCollision::PushPull;
+        for (g, chunk) in tris.chunks(LANES).enumerate() {
+            let (mut p0, mut p1, mut p2) = (V3::ZERO, V3::ZERO, V3::ZERO);
+            let mut r = F([0.0; LANES]);
+            for (l, &[i0, i1, i2]) in chunk.iter().enumerate() {
+                let [i0, i1, i2] = [i0, i1, i2].map(|i| i as usize);
+                p0.set(l, self.pos[i0]);
+                p1.set(l, self.pos[i1]);
+                p2.set(l, self.pos[i2]);
+                r.0[l] = rig.radius[i0] + rig.radius[i1] + rig.radius[i2];
+            }
+            let (p0, p1, p2) = (V3::<T>::of(p0), V3::<T>::of(p1), V3::<T>::of(p2));
+            let r = T::of(r) / T::splat(3.0);
+            // `TriangleFrame::of`.
+            let raw = (p1 - p0).cross(p2 - p0);
+            let raw2 = raw.dot(raw);
+            let valid = raw2.lt(T::splat(1e-14)).not();
+            let normal = raw * (T::splat(1.0) / raw2.sqrt());
+            let centroid = (p0 + p1 + p2) / T::splat(3.0);
+            let (d0, d1, d2) = (p0 - centroid, p1 - centroid, p2 - centroid);
+            let bound = d0.dot(d0).max(d1.dot(d1)).max(d2.dot(d2)).sqrt();
+            let (validm, nf, cf, bf) = (valid.m(), normal.f(), centroid.f(), bound.f());
+            for l in 0..chunk.len() {
+                scratch
+                    .frames
+                    .push((validm.0[l] != 0).then(|| TriangleFrame {
+                        normal: nf.get(l),
+                        centroid: cf.get(l),
+                        bound: bf.0[l],
+                    }));
+            }
+            let zero = T::splat(0.0);
+            let (one, minus_one) = (T::splat(1.0), T::splat(-1.0));
+            for (slot, core) in cores.iter().enumerate() {
+                let Some(core) = core else { continue };
+                let (e0, e1) = (V3::<T>::splat(core.e0), V3::<T>::splat(core.e1));
+                let radius = T::splat(core.radius) + r;
+                // The cheap reject (the side memory still learns where the collider is).
+                let near = closest_point_on_segment(centroid, e0, e1);
+                let far = (near - centroid).length().gt(bound + radius);
+                let side_far = T::select(zero.le(normal.dot(near - p0)), one, minus_one);
+                let close = far.not().and(valid);
+                let mut side = side_far;
+                // Lanes the scalar code must do (a push, or a NaN on the way to one).
+                let mut ask = <T::M as Mask>::NONE;
+                if close.any() {
+                    // Closest points by alternating projections.
+                    let mut c = near;
+                    let mut q = closest_point_on_triangle(c, p0, p1, p2);
+                    if core.e0 != core.e1 {
+                        let mut going = close;
+                        for _ in 0..4 {
+                            if !going.any() {
+                                break;
+                            }
+                            let next = closest_point_on_segment(q, e0, e1);
+                            going = going.and(next.bits_eq(c).not());
+                            c = V3::select(going, next, c);
+                            q = V3::select(going, closest_point_on_triangle(c, p0, p1, p2), q);
+                        }
+                    }
+                    let signed = normal.dot(c - p0);
+                    let dist = (c - q).length();
+                    let off = c - normal * signed - q;
+                    let over_face = off.dot(off).lt(T::splat(1e-10));
+                    let current = T::select(zero.le(signed), one, minus_one);
+                    let mut before = F([0.0; LANES]);
+                    for l in 0..chunk.len() {
+                        before.0[l] = f32::from(sides[(g * LANES + l) * m + slot]);
+                    }
+                    let before = T::of(before);
+                    let engaged = if push_pull {
+                        over_face.and(signed.abs().lt(T::splat(2.0) * radius))
+                    } else {
+                        <T::M as Mask>::NONE
+                    };
+                    let sigma = T::select(before.ne(zero), before, current);
+                    let violation = radius - sigma * signed;
+                    // Pushes: engaged and `!(violation <= 0)`, else `!(dist > radius)`.
+                    let pushes = engaged
+                        .and(violation.le(zero).not())
+                        .or(engaged.not().and(dist.gt(radius).not()));
+                    side = T::select(close, T::select(engaged, sigma, current), side);
+                    ask = close.and(pushes);
+                }
+                let (side, ask) = (side.f(), ask.m());
+                for l in 0..chunk.len() {
+                    scratch.sides[(g * LANES + l) * m + slot] = if ask.0[l] != 0 {
+                        0
+                    } else if side.0[l] > 0.0 {
+                        1
+                    } else {
+                        -1
+                    };
+                }
+            }
+        }
+        let points = cloth.points.clone();
+        scratch.dirty[points].iter_mut().for_each(|d| *d = false);
+        let mut touched = false;
+        for (t, &[i0, i1, i2]) in tris.iter().enumerate() {
+            let [i0, i1, i2] = [i0, i1, i2].map(|i| i as usize);
+            let free = [!rig.fixed[i0], !rig.fixed[i1], !rig.fixed[i2]];
+            if !free.iter().any(|f| *f) {
+                // Every collider leaves a triangle without a free corner alone.
+                continue;
+            }
+            let r = (rig.radius[i0] + rig.radius[i1] + rig.radius[i2]) / 3.0;
+            let corners = [self.pos[i0], self.pos[i1], self.pos[i2]];
+            let sides = &mut sides[t * m..(t + 1) * m];
+            let (after, moved) = if scratch.dirty[i0] || scratch.dirty[i1] || scratch.dirty[i2] {
+                push_triangle_against(corners, free, r, cores, mode, sides)
+            } else {
+                // A degenerate triangle is left alone by every collider.
+                let Some(frame) = scratch.frames[t] else {
+                    continue;
+                };
+                let mut result = (corners, false);
+                for slot in 0..m {
+                    if cores[slot].is_none() {
+                        continue;
+                    }
+                    match scratch.sides[t * m + slot] {
+                        0 => {
+                            result = push_triangle_against_from(
+                                corners,
+                                Some(frame),
+                                free,
+                                r,
+                                &cores[slot..],
+                                mode,
+                                &mut sides[slot..],
+                            );
+                            break;
+                        }
+                        side => sides[slot] = side,
+                    }
+                }
+                result
+            };
+            touched |= moved;
+            for (corner, i) in after.into_iter().zip([i0, i1, i2]) {
+                if !same_bits(corner, self.pos[i]) {
+                    scratch.dirty[i] = true;
+                }
+                self.pos[i] = corner;
+            }
+        }
+        touched
+    }
+}
+
+/// glam's `Vec3::max_element` per lane: `max(x, max(y, z))` with `a > b ? a : b`.
+#[inline(always)]
+fn max_element<T: Lane>(v: V3<T>) -> T {
+    let yz = T::select(v.y.gt(v.z), v.y, v.z);
+    T::select(v.x.gt(yz), v.x, yz)
+}
+
+/// [`crate::math::closest_point_on_triangle`] per lane: every region's point computed,
+/// the scalar function's choice made per lane in its order (vertex A, vertex B, edge AB,
+/// vertex C, edge AC, edge BC, a degenerate triangle, the face).
+#[inline(always)]
+fn closest_point_on_triangle<T: Lane>(p: V3<T>, a: V3<T>, b: V3<T>, c: V3<T>) -> V3<T> {
+    let zero = T::splat(0.0);
+    let ab = b - a;
+    let ac = c - a;
+    let ap = p - a;
+    let d1 = ab.dot(ap);
+    let d2 = ac.dot(ap);
+    let mut done = d1.le(zero).and(d2.le(zero));
+    let mut out = a;
+    let bp = p - b;
+    let d3 = ab.dot(bp);
+    let d4 = ac.dot(bp);
+    let mut take = |m: T::M, v: V3<T>, out: &mut V3<T>| {
+        let m = m.and(done.not());
+        *out = V3::select(m, v, *out);
+        done = done.or(m);
+    };
+    take(zero.le(d3).and(d4.le(d3)), b, &mut out);
+    let vc = d1 * d4 - d3 * d2;
+    let v = d1 / (d1 - d3);
+    take(
+        vc.le(zero).and(zero.le(d1)).and(d3.le(zero)),
+        a + ab * v,
+        &mut out,
+    );
+    let cp = p - c;
+    let d5 = ab.dot(cp);
+    let d6 = ac.dot(cp);
+    take(zero.le(d6).and(d5.le(d6)), c, &mut out);
+    let vb = d5 * d2 - d1 * d6;
+    let w = d2 / (d2 - d6);
+    take(
+        vb.le(zero).and(zero.le(d2)).and(d6.le(zero)),
+        a + ac * w,
+        &mut out,
+    );
+    let va = d3 * d6 - d5 * d4;
+    let (d43, d56) = (d4 - d3, d5 - d6);
+    let w = d43 / (d43 + d56);
+    take(
+        va.le(zero).and(zero.le(d43)).and(zero.le(d56)),
+        b + (c - b) * w,
+        &mut out,
+    );
+    let denom = va + vb + vc;
+    take(denom.abs().lt(T::splat(1e-30)), a, &mut out);
+    let v = vb / denom;
+    let w = vc / denom;
+    take(<T::M as Mask>::ALL, a + ab * v + ac * w, &mut out);
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::closest_point_on_triangle as scalar;
+    use crate::rng::SplitMix64;
+
+    /// The lanes' closest point on a triangle against the scalar function, bit for bit,
+    /// with points in every region (vertices, edges, face), degenerate triangles (a
+    /// point, a segment) and a point on a corner.
+    #[test]
+    fn closest_point_on_triangle_in_lanes_gives_the_scalar_bits() {
+        let mut rng = SplitMix64::new(5);
+        let mut u = |lo: f32, hi: f32| rng.range_f32(lo, hi);
+        for round in 0..20_000 {
+            let mut v = || Vec3::new(u(-1.0, 1.0), u(-1.0, 1.0), u(-1.0, 1.0));
+            let (mut a, mut b, mut c, mut p) = (V3::ZERO, V3::ZERO, V3::ZERO, V3::ZERO);
+            let mut want = [Vec3::ZERO; LANES];
+            for l in 0..LANES {
+                let (ta, mut tb, mut tc) = (v(), v(), v());
+                let mut tp = v() * 2.0;
+                match (round + l) % 11 {
+                    0 => tb = ta,
+                    1 => {
+                        tb = ta;
+                        tc = ta;
+                    }
+                    2 => tc = ta + (tb - ta) * 0.5,
+                    3 => tp = ta,
+                    _ => {}
+                }
+                a.set(l, ta);
+                b.set(l, tb);
+                c.set(l, tc);
+                p.set(l, tp);
+                want[l] = scalar(tp, ta, tb, tc);
+            }
+            let got = closest_point_on_triangle::<F>(p, a, b, c);
+            for (l, w) in want.iter().enumerate() {
+                assert!(
+                    same_bits(got.get(l), *w),
+                    "round {round}, lane {l}: {} vs {w}",
+                    got.get(l)
+                );
+            }
+        }
+    }
+}
