@@ -34,6 +34,8 @@ use super::avx::Fa;
 /// state; sized on first use, so a frame allocates nothing.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct ClothLaneScratch {
+    /// The cloth's colliders as the point pass sees them.
+    shapes: Vec<PointShape>,
     /// Per point: moved by a push earlier in this pass.
     dirty: Vec<bool>,
     /// Per structural segment: bit `j` set when core slot `j` rejects it.
@@ -84,6 +86,38 @@ pub(crate) fn collide(
     pass.run::<F>()
 }
 
+/// A collider as the point pass asks it: where it is, its bounding radius (`None`: it
+/// acts everywhere), and for keep-out spheres and capsules the radius whose contact the
+/// lanes decide (a capsule with its axis ends).
+#[derive(Debug, Clone, Copy)]
+struct PointShape {
+    index: usize,
+    centre: Vec3,
+    bound: Option<f32>,
+    radius: Option<f32>,
+    ends: Option<(Vec3, Vec3)>,
+}
+
+impl PointShape {
+    fn of_at(index: usize, col: &PlacedCollider) -> PointShape {
+        let (radius, ends) = match col.shape {
+            Shape::Sphere {
+                radius,
+                inside: false,
+            } => (Some(radius), None),
+            Shape::Capsule { radius, length } => (Some(radius), Some(col.capsule_ends(length))),
+            _ => (None, None),
+        };
+        PointShape {
+            index,
+            centre: col.transform.translation,
+            bound: col.bounding_radius(),
+            radius,
+            ends,
+        }
+    }
+}
+
 /// One `collide` call's inputs.
 struct Pass<'a> {
     rig: &'a ClothRig,
@@ -110,10 +144,7 @@ impl Pass<'_> {
     fn run<T: Lane>(&mut self) -> bool {
         let (rig, colliders) = (self.rig, self.colliders);
         let cloth = &rig.cloths[self.ci];
-        let mut touched = false;
-        for &k in &cloth.colliders {
-            touched |= self.points::<T>(&colliders[k]);
-        }
+        let mut touched = self.points::<T>();
         self.cores.clear();
         self.cores
             .extend(cloth.colliders.iter().map(|&k| Core::of(&colliders[k])));
@@ -130,23 +161,26 @@ impl Pass<'_> {
         touched
     }
 
-    /// Every free point against `col`, [`LANES`] at a time, as
-    /// [`PlacedCollider::resolve`]; a moved point is written back (and gets the cloth's
-    /// friction with `contact`). Returns whether any moved.
+    /// Every free point against the cloth's colliders in order, as
+    /// [`PlacedCollider::resolve`] one collider after another, [`LANES`] points at a time
+    /// (a point's answer depends on that point alone, so taking the points of a group
+    /// through every collider gives what the scalar pass, collider by collider, gives). A
+    /// moved point is written back (and gets the cloth's friction with `contact`).
+    /// Returns whether any moved.
     #[inline(always)]
-    fn points<T: Lane>(&mut self, col: &PlacedCollider) -> bool {
+    fn points<T: Lane>(&mut self) -> bool {
         let rig = self.rig;
-        let points = rig.cloths[self.ci].points.clone();
-        let centre = V3::<T>::splat(col.transform.translation);
-        let bound = col.bounding_radius();
-        let (ends, decision) = match col.shape {
-            Shape::Sphere {
-                radius,
-                inside: false,
-            } => (None, Some(radius)),
-            Shape::Capsule { radius, length } => (Some(col.capsule_ends(length)), Some(radius)),
-            _ => (None, None),
-        };
+        let cloth = &rig.cloths[self.ci];
+        let shapes = &mut self.scratch.shapes;
+        shapes.clear();
+        shapes.extend(
+            cloth
+                .colliders
+                .iter()
+                .map(|&k| PointShape::of_at(k, &self.colliders[k])),
+        );
+        let shapes = &self.scratch.shapes;
+        let points = cloth.points.clone();
         let mut touched = false;
         let mut start = points.start;
         while start < points.end {
@@ -163,54 +197,68 @@ impl Pass<'_> {
                 r.0[l] = rig.radius[p];
             }
             let (x, q, r) = (V3::<T>::of(x), V3::<T>::of(q), T::of(r));
-            let mut ask = <T::M as Mask>::of(active);
-            // `resolve`'s quick rejection: both ends of the step beyond the shape's
-            // bounding sphere and the step too short to reach it.
-            if let Some(bound) = bound {
-                let reach = T::splat(bound) + r;
-                let reach2 = reach * reach;
-                let (dp, dq, step) = (x - centre, q - centre, x - q);
-                let gap = dp.length() - reach;
-                let rejected = dp
-                    .dot(dp)
-                    .gt(reach2)
-                    .and(dq.dot(dq).gt(reach2))
-                    .and(step.dot(step).lt(gap * gap));
-                ask = ask.and(rejected.not());
-            }
-            if ask.any() {
-                let mut y = x;
-                if let Some(radius) = decision {
+            let active = <T::M as Mask>::of(active);
+            // `y`: the point as the colliders so far left it; `moved`: lanes any changed.
+            let (mut y, mut moved) = (x, <T::M as Mask>::NONE);
+            for shape in shapes {
+                // Without a step start, each collider takes the point as it finds it.
+                let from = if self.prev.is_some() { q } else { y };
+                let centre = V3::<T>::splat(shape.centre);
+                let mut ask = active;
+                // `resolve`'s quick rejection: both ends of the step beyond the shape's
+                // bounding sphere and the step too short to reach it.
+                if let Some(bound) = shape.bound {
+                    let reach = T::splat(bound) + r;
+                    let reach2 = reach * reach;
+                    let (dp, dq, step) = (y - centre, from - centre, y - from);
+                    let gap = dp.length() - reach;
+                    let rejected = dp
+                        .dot(dp)
+                        .gt(reach2)
+                        .and(dq.dot(dq).gt(reach2))
+                        .and(step.dot(step).lt(gap * gap));
+                    ask = ask.and(rejected.not());
+                }
+                if !ask.any() {
+                    continue;
+                }
+                let mut after = y;
+                if let Some(radius) = shape.radius {
                     let limit = T::splat(radius) + r;
-                    let c = match ends {
-                        Some((a, b)) => capsule_contact(x, q, V3::splat(a), V3::splat(b), limit),
-                        None => sphere_contact(x, q, centre, limit),
+                    let c = match shape.ends {
+                        Some((a, b)) => capsule_contact(y, from, V3::splat(a), V3::splat(b), limit),
+                        None => sphere_contact(y, from, centre, limit),
                     };
                     ask = ask.and(c.may);
-                    y = V3::select(ask.and(c.entered.not()), c.pushed, y);
+                    after = V3::select(ask.and(c.entered.not()), c.pushed, after);
                     ask = ask.and(c.entered);
                 }
                 // The scalar collider for what the lanes leave: entries, other shapes.
-                let (ask, mut yf) = (ask.m(), y.f());
-                for l in 0..n {
-                    if ask.0[l] != 0 {
-                        let p = start + l;
-                        let from = self.prev.map_or(self.pos[p], |pr| pr[p]);
-                        yf.set(l, col.resolve(self.pos[p], from, rig.radius[p]));
-                    }
-                }
-                // Written back where it differs by value, as the scalar `after != before`.
-                let moved = differs(V3::<T>::of(yf), x).and(<T::M as Mask>::of(active));
-                if moved.any() {
-                    let moved = moved.m();
+                if ask.any() {
+                    let (ask, mut af, yf, ff) = (ask.m(), after.f(), y.f(), from.f());
+                    let col = &self.colliders[shape.index];
                     for l in 0..n {
-                        if moved.0[l] != 0 {
+                        if ask.0[l] != 0 {
                             let p = start + l;
-                            self.pos[p] = yf.get(l);
-                            touched = true;
-                            if let Some((friction, _)) = self.contact.as_mut() {
-                                friction[p] = rig.friction[p];
-                            }
+                            af.set(l, col.resolve(yf.get(l), ff.get(l), rig.radius[p]));
+                        }
+                    }
+                    after = V3::of(af);
+                }
+                // Taken where it differs by value, as the scalar `after != before`.
+                let changed = differs(after, y).and(active);
+                y = V3::select(changed, after, y);
+                moved = moved.or(changed);
+            }
+            if moved.any() {
+                let (moved, yf) = (moved.m(), y.f());
+                for l in 0..n {
+                    if moved.0[l] != 0 {
+                        let p = start + l;
+                        self.pos[p] = yf.get(l);
+                        touched = true;
+                        if let Some((friction, _)) = self.contact.as_mut() {
+                            friction[p] = rig.friction[p];
                         }
                     }
                 }
