@@ -55,6 +55,35 @@ pub(crate) struct CompiledCloth {
     /// The quads' triangles in the order the surface collision takes them: per quad
     /// `[p00, p10, p11]` then `[p00, p11, p01]`.
     pub triangles: Vec<[u32; 3]>,
+    /// The constraints (global indices) by dependency level ([`dependency_levels`]).
+    pub schedule: Vec<u32>,
+}
+
+/// `constraints` (global indices `first..`) reordered by dependency level, stably: a
+/// constraint's level is one more than the highest level of the constraints before it
+/// (in the rig's order) that share a point with it. Relaxed in this order, every
+/// constraint meets its two points as the rig's order leaves them — each constraint
+/// before it on one of its points has a lower level, each after it a higher one — so the
+/// results are the same bits, while the constraints of one level (no two share a point)
+/// are independent and the processor overlaps their latencies.
+pub(crate) fn dependency_levels(constraints: &[ClothConstraint], first: usize) -> Vec<u32> {
+    let mut level_of_point: std::collections::HashMap<u32, u32> = Default::default();
+    let mut levelled: Vec<(u32, u32)> = constraints
+        .iter()
+        .enumerate()
+        .map(|(i, c)| {
+            let level = 1 + level_of_point
+                .get(&c.a)
+                .copied()
+                .unwrap_or(0)
+                .max(level_of_point.get(&c.b).copied().unwrap_or(0));
+            level_of_point.insert(c.a, level);
+            level_of_point.insert(c.b, level);
+            (level, (first + i) as u32)
+        })
+        .collect();
+    levelled.sort_by_key(|&(level, _)| level);
+    levelled.into_iter().map(|(_, i)| i).collect()
 }
 
 /// Every `[[cloth]]` of a rig compiled for one skeleton. Immutable: share it between the
@@ -303,6 +332,7 @@ impl ClothRig {
                 .iter()
                 .flat_map(|&[q00, q10, q11, q01]| [[q00, q10, q11], [q00, q11, q01]])
                 .collect();
+            let schedule = dependency_levels(&out.constraints[cstart..], cstart);
             out.cloths.push(CompiledCloth {
                 settings: s.clone(),
                 points: first..out.joint.len(),
@@ -312,6 +342,7 @@ impl ClothRig {
                 colliders,
                 structural,
                 triangles,
+                schedule,
             });
         }
         Ok(out)
@@ -391,5 +422,68 @@ impl ClothRig {
     /// Whether point `p` follows the animation.
     pub fn is_fixed(&self, p: usize) -> bool {
         self.fixed[p]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The schedule of the built-in skirt (every constraint family, a closed ring):
+    /// a permutation of the cloth's constraints in which every pair that shares a point
+    /// keeps the rig's order (what makes the results the same bits), and which really
+    /// brings independent constraints together (levels of several).
+    #[test]
+    fn the_dependency_schedule_keeps_the_order_of_every_pair_that_shares_a_point() {
+        let c = crate::builtin::character();
+        let rig = ClothRig::new(&c.skeleton, &c.rig).unwrap();
+        let cloth = &rig.cloths[0];
+        let range = cloth.constraints.clone();
+        let mut at = vec![usize::MAX; rig.constraints.len()];
+        for (k, &i) in cloth.schedule.iter().enumerate() {
+            assert!(range.contains(&(i as usize)), "{i} is not the cloth's");
+            assert_eq!(at[i as usize], usize::MAX, "{i} twice");
+            at[i as usize] = k;
+        }
+        assert_eq!(cloth.schedule.len(), range.len());
+        let mut pairs = 0;
+        for i in range.clone() {
+            for k in i + 1..range.end {
+                let (x, y) = (&rig.constraints[i], &rig.constraints[k]);
+                if [x.a, x.b].iter().any(|p| *p == y.a || *p == y.b) {
+                    pairs += 1;
+                    assert!(
+                        at[i] < at[k],
+                        "constraints {i} and {k} share a point: order kept"
+                    );
+                }
+            }
+        }
+        assert!(pairs > 100, "{pairs}");
+        // Runs of the schedule in which no two constraints share a point: how far the
+        // schedule groups independent work (the rig's order has runs of 1–2 only).
+        let runs = |order: &[u32]| {
+            let mut runs = 1;
+            let mut seen: Vec<u32> = Vec::new();
+            for &i in order {
+                let c = &rig.constraints[i as usize];
+                if seen.contains(&c.a) || seen.contains(&c.b) {
+                    runs += 1;
+                    seen.clear();
+                }
+                seen.extend([c.a, c.b]);
+            }
+            runs
+        };
+        let rig_order: Vec<u32> = range.map(|i| i as u32).collect();
+        let (scheduled, ordered) = (runs(&cloth.schedule), runs(&rig_order));
+        println!(
+            "skirt: {} constraints in {scheduled} independent runs (rig order: {ordered})",
+            rig_order.len()
+        );
+        assert!(
+            scheduled * 2 < ordered,
+            "{scheduled} independent runs scheduled vs {ordered} in the rig's order"
+        );
     }
 }
