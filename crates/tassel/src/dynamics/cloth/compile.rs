@@ -55,8 +55,47 @@ pub(crate) struct CompiledCloth {
     /// The quads' triangles in the order the surface collision takes them: per quad
     /// `[p00, p10, p11]` then `[p00, p11, p01]`.
     pub triangles: Vec<[u32; 3]>,
-    /// The constraints (global indices) by dependency level ([`dependency_levels`]).
-    pub schedule: Vec<u32>,
+    /// The constraints by dependency level ([`dependency_levels`]), as the relaxation
+    /// reads them.
+    pub relaxed: Vec<Relaxed>,
+}
+
+/// A constraint as its relaxation reads it: ends, rest length, strengths, and the
+/// weights of its ends (1 movable, 0 fixed) and the share of the correction each movable
+/// end takes, which depend on the rig only.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Relaxed {
+    pub a: u32,
+    pub b: u32,
+    pub length: f32,
+    pub shrink: f32,
+    pub stretch: f32,
+    pub wa: f32,
+    pub wb: f32,
+    pub share: f32,
+}
+
+impl Relaxed {
+    /// Constraint `c` of a rig whose fixed points are `fixed`.
+    #[inline(always)]
+    pub(crate) fn of(c: &ClothConstraint, fixed: &[bool]) -> Relaxed {
+        let wa = if fixed[c.a as usize] { 0.0 } else { 1.0 };
+        let wb = if fixed[c.b as usize] { 0.0 } else { 1.0 };
+        // The correction is shared among the movable ends (the rig has no constraint
+        // between two fixed points): divided by 1 or 2, written as a product by 1 or 0.5,
+        // which is exact either way (the same bits), without a division.
+        let share = if wa + wb > 1.5 { 0.5 } else { 1.0 };
+        Relaxed {
+            a: c.a,
+            b: c.b,
+            length: c.length,
+            shrink: c.shrink,
+            stretch: c.stretch,
+            wa,
+            wb,
+            share,
+        }
+    }
 }
 
 /// `constraints` (global indices `first..`) reordered by dependency level, stably: a
@@ -333,6 +372,10 @@ impl ClothRig {
                 .flat_map(|&[q00, q10, q11, q01]| [[q00, q10, q11], [q00, q11, q01]])
                 .collect();
             let schedule = dependency_levels(&out.constraints[cstart..], cstart);
+            let relaxed = schedule
+                .iter()
+                .map(|&i| Relaxed::of(&out.constraints[i as usize], &out.fixed))
+                .collect();
             out.cloths.push(CompiledCloth {
                 settings: s.clone(),
                 points: first..out.joint.len(),
@@ -342,7 +385,7 @@ impl ClothRig {
                 colliders,
                 structural,
                 triangles,
-                schedule,
+                relaxed,
             });
         }
         Ok(out)
@@ -439,13 +482,24 @@ mod tests {
         let rig = ClothRig::new(&c.skeleton, &c.rig).unwrap();
         let cloth = &rig.cloths[0];
         let range = cloth.constraints.clone();
+        let schedule = dependency_levels(&rig.constraints[range.clone()], range.start);
+        // The cloth relaxes its constraints in that order.
+        let ends = |c: &Relaxed| (c.a, c.b);
+        let scheduled_ends: Vec<_> = schedule
+            .iter()
+            .map(|&i| (rig.constraints[i as usize].a, rig.constraints[i as usize].b))
+            .collect();
+        assert_eq!(
+            cloth.relaxed.iter().map(ends).collect::<Vec<_>>(),
+            scheduled_ends
+        );
         let mut at = vec![usize::MAX; rig.constraints.len()];
-        for (k, &i) in cloth.schedule.iter().enumerate() {
+        for (k, &i) in schedule.iter().enumerate() {
             assert!(range.contains(&(i as usize)), "{i} is not the cloth's");
             assert_eq!(at[i as usize], usize::MAX, "{i} twice");
             at[i as usize] = k;
         }
-        assert_eq!(cloth.schedule.len(), range.len());
+        assert_eq!(schedule.len(), range.len());
         let mut pairs = 0;
         for i in range.clone() {
             for k in i + 1..range.end {
@@ -476,7 +530,7 @@ mod tests {
             runs
         };
         let rig_order: Vec<u32> = range.map(|i| i as u32).collect();
-        let (scheduled, ordered) = (runs(&cloth.schedule), runs(&rig_order));
+        let (scheduled, ordered) = (runs(&schedule), runs(&rig_order));
         println!(
             "skirt: {} constraints in {scheduled} independent runs (rig order: {ordered})",
             rig_order.len()

@@ -1,6 +1,6 @@
 //! Per-character cloth state and the frame job.
 
-use super::compile::{ClothConstraint, ClothRig, ConstraintKind};
+use super::compile::{ClothRig, ConstraintKind, Relaxed};
 use super::contact::{push_segment, push_triangle_against, Core};
 use crate::collide::PlacedCollider;
 use crate::controller::Level;
@@ -424,13 +424,13 @@ fn step(rig: &ClothRig, ci: usize, state: &mut ClothState, h: f32, level: Option
         if state.simd == SimdUse::Scalar {
             // The readable reference: the rig's order.
             for c in &rig.constraints[cloth.constraints.clone()] {
-                relax(rig, c, &mut state.pos);
+                relax(&Relaxed::of(c, &rig.fixed), &mut state.pos);
             }
         } else {
             // The same constraints by dependency level (`compile::dependency_levels`):
             // the same bits, the independent ones side by side.
-            for &i in &cloth.schedule {
-                relax(rig, &rig.constraints[i as usize], &mut state.pos);
+            for c in &cloth.relaxed {
+                relax(c, &mut state.pos);
             }
         }
         let ClothState {
@@ -489,14 +489,8 @@ fn step(rig: &ClothRig, ci: usize, state: &mut ClothState, h: f32, level: Option
 /// One distance constraint relaxed once: its length error corrected by the share its
 /// strength says, split between its movable ends.
 #[inline(always)]
-fn relax(rig: &ClothRig, c: &ClothConstraint, pos: &mut [Vec3]) {
+fn relax(c: &Relaxed, pos: &mut [Vec3]) {
     let (a, b) = (c.a as usize, c.b as usize);
-    let wa = if rig.fixed[a] { 0.0 } else { 1.0 };
-    let wb = if rig.fixed[b] { 0.0 } else { 1.0 };
-    // The correction is shared among the movable ends (the rig has no constraint between
-    // two fixed points): divided by 1 or 2, written as a product by 1 or 0.5, which is
-    // exact either way (the same bits), without a division.
-    let share = if wa + wb > 1.5 { 0.5 } else { 1.0 };
     let d = pos[b] - pos[a];
     let len = d.length();
     if len < 1e-9 {
@@ -507,9 +501,9 @@ fn relax(rig: &ClothRig, c: &ClothConstraint, pos: &mut [Vec3]) {
     if strength <= 0.0 {
         return;
     }
-    let corr = d * (diff / len * strength * share);
-    pos[a] += corr * wa;
-    pos[b] -= corr * wb;
+    let corr = d * (diff / len * strength * c.share);
+    pos[a] += corr * c.wa;
+    pos[b] -= corr * c.wb;
 }
 
 /// [`collide`] by the code `simd` chooses: the scalar reference itself, or the same
