@@ -300,6 +300,14 @@ impl Pass<'_> {
             }
             scratch.far.extend_from_slice(&far[..chunk.len()]);
         }
+        // The core slots the lanes answer for: a segment all of them reject is done.
+        let all = cores
+            .iter()
+            .take(64)
+            .enumerate()
+            .filter(|(_, c)| c.is_some())
+            .fold(0u64, |bits, (slot, _)| bits | 1 << slot);
+        let every_slot_answered = cores.len() <= 64;
         let points = cloth.points.clone();
         scratch.dirty[points].iter_mut().for_each(|d| *d = false);
         let mut touched = false;
@@ -312,6 +320,9 @@ impl Pass<'_> {
             } else {
                 scratch.far[i]
             };
+            if every_slot_answered && far == all {
+                continue;
+            }
             let r = 0.5 * (rig.radius[a] + rig.radius[b]);
             let (lo, hi) = (self.pos[a].min(self.pos[b]), self.pos[a].max(self.pos[b]));
             for (slot, core) in cores.iter().enumerate() {
