@@ -59,21 +59,8 @@ fn assert_lanes_match(sk: &Skeleton, rig: &RigSettings, swing: usize, frames: us
             .collect();
         let reference = &sims[0];
         for (k, (sim, pose)) in sims.iter().zip(&poses).enumerate().skip(1) {
-            for j in 0..sk.len() {
-                assert_eq!(
-                    common::transform_bits(&pose.locals[j]),
-                    common::transform_bits(&poses[0].locals[j]),
-                    "frame {f}, way {k} ({:?}), joint '{}': {:?} vs scalar {:?}",
-                    ways[k],
-                    sk.name(j),
-                    pose.locals[j],
-                    poses[0].locals[j]
-                );
-                assert_eq!(
-                    common::transform_bits(&pose.models[j]),
-                    common::transform_bits(&poses[0].models[j])
-                );
-            }
+            let what = format!("frame {f}, way {k} ({:?})", ways[k]);
+            common::assert_pose_bits(sk, &what, pose, &poses[0]);
             let (a, b) = (sim.chain_state(), reference.chain_state());
             for (p, (x, y)) in a
                 .output_positions()

@@ -59,21 +59,8 @@ fn assert_lanes_match(
             .map(|sim| sim.frame(&locals, component, dt).unwrap().clone())
             .collect();
         for (k, pose) in poses.iter().enumerate().skip(1) {
-            for j in 0..sk.len() {
-                assert_eq!(
-                    common::transform_bits(&pose.locals[j]),
-                    common::transform_bits(&poses[0].locals[j]),
-                    "frame {f}, way {k} ({:?}), joint '{}': {:?} vs scalar {:?}",
-                    WAYS[k],
-                    sk.name(j),
-                    pose.locals[j],
-                    poses[0].locals[j]
-                );
-                assert_eq!(
-                    common::transform_bits(&pose.models[j]),
-                    common::transform_bits(&poses[0].models[j])
-                );
-            }
+            let what = format!("frame {f}, way {k} ({:?})", WAYS[k]);
+            common::assert_pose_bits(sk, &what, pose, &poses[0]);
             let (a, b) = (sims[k].cloth_state(), sims[0].cloth_state());
             let bits = |v: &[Vec3]| -> Vec<[u32; 3]> {
                 v.iter().map(|p| p.to_array().map(f32::to_bits)).collect()

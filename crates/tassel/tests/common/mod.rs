@@ -127,6 +127,27 @@ pub fn transform_bits(t: &Transform) -> [u32; 10] {
     b
 }
 
+/// Asserts that `pose` is `reference` bit for bit, joint by joint (local and model
+/// transforms); `what` says which frame and way in the message.
+pub fn assert_pose_bits(sk: &Skeleton, what: &str, pose: &tassel::Pose, reference: &tassel::Pose) {
+    for j in 0..sk.len() {
+        assert_eq!(
+            transform_bits(&pose.locals[j]),
+            transform_bits(&reference.locals[j]),
+            "{what}, joint '{}': {:?} vs the reference {:?}",
+            sk.name(j),
+            pose.locals[j],
+            reference.locals[j]
+        );
+        assert_eq!(
+            transform_bits(&pose.models[j]),
+            transform_bits(&reference.models[j]),
+            "{what}, joint '{}' (model)",
+            sk.name(j)
+        );
+    }
+}
+
 /// How many chain features [`chain_feature`] knows.
 pub const CHAIN_FEATURES: usize = 9;
 
