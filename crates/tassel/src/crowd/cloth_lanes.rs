@@ -2,8 +2,8 @@
 //! `collide` (points, structural segments and quad triangles against the cloth's
 //! colliders), giving the scalar function's bits.
 //!
-//! - **Points**: for one collider, every point's answer depends on that point alone, so
-//!   [`LANES`] points are tested side by side: the collider's quick rejection and, for
+//! - **Points**: a point's answer depends on that point alone, so [`LANES`] points go side
+//!   by side through every collider in order: the collider's quick rejection and, for
 //!   keep-out spheres and capsules, the narrow phase's contact decision and push out
 //!   (the chain lanes' own, `chain_step.rs`); a step that *entered* a shape, and every
 //!   other shape, goes to the scalar collider for the lanes that need it.
