@@ -191,8 +191,9 @@ pub struct VrmJob<'a> {
     /// In: animated local transforms. Out: with simulated rotations.
     pub locals: &'a mut [Transform],
     /// In: animated model transforms, the model pose of `locals` (as
-    /// [`LocalToModelJob`] computes it with the identity above the roots). Out: the model
-    /// pose of the new locals (joints no spring moves may keep the models given).
+    /// [`LocalToModelJob`](crate::LocalToModelJob) computes it with the identity above the
+    /// roots). Out: the model pose of the new locals (joints no spring moves may keep the
+    /// models given).
     pub models: &'a mut [Transform],
 }
 
