@@ -36,8 +36,9 @@ pub struct Args {
     /// character, the same threads) in the same run and print the ratio.
     #[arg(long, requires = "crowd")]
     compare: bool,
-    /// Which code runs the solvers that have a lane path (VRM springs, twin chains) in
-    /// one character: `scalar` is the readable reference (the same bits, slower).
+    /// Which code runs the solvers that have a lane path (VRM springs, twin chains, the
+    /// cloth's contact tests) in one character: `scalar` is the readable reference (the
+    /// same bits, slower).
     #[arg(long, value_enum, default_value_t = SimdBench::Auto, conflicts_with = "crowd")]
     simd: SimdBench,
 }

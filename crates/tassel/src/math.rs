@@ -163,6 +163,13 @@ pub fn slerp_shortest(a: Quat, b: Quat, t: f32) -> Quat {
     a.slerp(b, t).normalize()
 }
 
+/// Whether two vectors are the same bits (unlike `==`, which takes −0 for 0 and no NaN for
+/// itself): what the lane paths compare when they must give the scalar code's bits.
+#[inline]
+pub(crate) fn same_bits(a: Vec3, b: Vec3) -> bool {
+    a.to_array().map(f32::to_bits) == b.to_array().map(f32::to_bits)
+}
+
 /// Normalises `v`, or returns `fallback` when `v` is too short to have a direction.
 #[inline]
 pub fn normalize_or(v: Vec3, fallback: Vec3) -> Vec3 {

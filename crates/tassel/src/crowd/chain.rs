@@ -771,11 +771,10 @@ fn motion(
 
 /// Whether two transforms are the same bits.
 fn same_bits(a: &Transform, b: &Transform) -> bool {
-    let v = |x: Vec3| x.to_array().map(f32::to_bits);
     let q = |x: Quat| x.to_array().map(f32::to_bits);
-    v(a.translation) == v(b.translation)
+    crate::math::same_bits(a.translation, b.translation)
         && q(a.rotation) == q(b.rotation)
-        && v(a.scale) == v(b.scale)
+        && crate::math::same_bits(a.scale, b.scale)
 }
 
 /// Checks one character's input: the pose's length, finite unit-rotation locals within

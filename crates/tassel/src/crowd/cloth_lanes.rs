@@ -22,9 +22,10 @@ use super::lanes::{closest_point_on_segment, differs, Lane, Mask, F, LANES, M, V
 use crate::collide::{PlacedCollider, Shape};
 use crate::dynamics::cloth::compile::ClothRig;
 use crate::dynamics::cloth::contact::{
-    push_segment, push_triangle_against, push_triangle_against_from, same_bits, Core, TriangleFrame,
+    push_segment, push_triangle_against, push_triangle_against_from, Core, TriangleFrame,
 };
 use crate::dynamics::cloth::SurfaceCollision;
+use crate::math::same_bits;
 use glam::Vec3;
 
 #[cfg(target_arch = "x86_64")]

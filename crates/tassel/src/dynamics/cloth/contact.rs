@@ -5,7 +5,7 @@ use super::settings::SurfaceCollision;
 use crate::collide::{PlacedCollider, Shape};
 use crate::math::{
     closest_params_segment_segment, closest_point_on_segment, closest_point_on_triangle,
-    normalize_or,
+    normalize_or, same_bits,
 };
 use glam::Vec3;
 
@@ -238,11 +238,6 @@ pub(crate) fn push_triangle_against_from(
         }
     }
     (corners, touched)
-}
-
-/// Whether two vectors are the same bits (unlike `==`, which takes −0 for 0).
-pub(crate) fn same_bits(a: Vec3, b: Vec3) -> bool {
-    a.to_array().map(f32::to_bits) == b.to_array().map(f32::to_bits)
 }
 
 #[cfg(test)]

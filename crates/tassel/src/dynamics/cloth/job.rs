@@ -100,8 +100,10 @@ impl ClothState {
     }
 
     /// Which code runs the contact tests (points, segments and quads against the
-    /// colliders): lanes by default ([`SimdUse::Auto`]), [`SimdUse::Scalar`] for the
-    /// readable reference. Every choice gives the same bits.
+    /// colliders) and in which order the constraints are relaxed: lanes and the
+    /// dependency-level order by default ([`SimdUse::Auto`]), [`SimdUse::Scalar`] for the
+    /// readable reference (scalar tests, the rig's order). Every choice gives the same
+    /// bits.
     pub fn set_simd(&mut self, simd: SimdUse) {
         self.simd = simd;
     }
