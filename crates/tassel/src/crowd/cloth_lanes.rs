@@ -372,6 +372,8 @@ impl Pass<'_> {
         scratch.sides.clear();
         scratch.sides.resize(tris.len() * m, 0);
         let push_pull = mode == SurfaceCollision::PushPull;
+        // A close pair whose projections wait for a second one to run beside.
+        let mut waiting: Option<ClosePair<T>> = None;
         for (g, chunk) in tris.chunks(LANES).enumerate() {
             let (mut p0, mut p1, mut p2) = (V3::ZERO, V3::ZERO, V3::ZERO);
             let mut r = F([0.0; LANES]);
@@ -413,60 +415,49 @@ impl Pass<'_> {
                 let far = (near - centroid).length().gt(bound + radius);
                 let side_far = T::select(zero.le(normal.dot(near - p0)), one, minus_one);
                 let close = far.not().and(valid);
-                let mut side = side_far;
-                // Lanes the scalar code must do (a push, or a NaN on the way to one).
-                let mut ask = <T::M as Mask>::NONE;
-                if close.any() {
-                    // Closest points by alternating projections.
-                    let mut c = near;
-                    let mut q = closest_point_on_triangle(c, p0, p1, p2);
-                    if core.e0 != core.e1 {
-                        let mut going = close;
-                        for _ in 0..4 {
-                            if !going.any() {
-                                break;
-                            }
-                            let next = closest_point_on_segment(q, e0, e1);
-                            going = going.and(next.bits_eq(c).not());
-                            c = V3::select(going, next, c);
-                            q = V3::select(going, closest_point_on_triangle(c, p0, p1, p2), q);
-                        }
-                    }
-                    let signed = normal.dot(c - p0);
-                    let dist = (c - q).length();
-                    let off = c - normal * signed - q;
-                    let over_face = off.dot(off).lt(T::splat(1e-10));
-                    let current = T::select(zero.le(signed), one, minus_one);
-                    let mut before = F([0.0; LANES]);
+                if !close.any() {
+                    let side = side_far.f();
+                    let at = g * LANES * m + slot;
                     for l in 0..chunk.len() {
-                        before.0[l] = f32::from(sides[(g * LANES + l) * m + slot]);
+                        scratch.sides[at + l * m] = if side.0[l] > 0.0 { 1 } else { -1 };
                     }
-                    let before = T::of(before);
-                    let engaged = if push_pull {
-                        over_face.and(signed.abs().lt(T::splat(2.0) * radius))
+                    continue;
+                }
+                let pair = ClosePair {
+                    at: g * LANES * m + slot,
+                    len: chunk.len(),
+                    corners: [p0, p1, p2],
+                    normal,
+                    ends: (e0, e1),
+                    radius,
+                    close,
+                    side_far,
+                    c: near,
+                    q: closest_point_on_triangle(near, p0, p1, p2),
+                    // A sphere's core is a point: its closest point is already found.
+                    going: if core.e0 != core.e1 {
+                        close
                     } else {
                         <T::M as Mask>::NONE
-                    };
-                    let sigma = T::select(before.ne(zero), before, current);
-                    let violation = radius - sigma * signed;
-                    // Pushes: engaged and `!(violation <= 0)`, else `!(dist > radius)`.
-                    let pushes = engaged
-                        .and(violation.le(zero).not())
-                        .or(engaged.not().and(dist.gt(radius).not()));
-                    side = T::select(close, T::select(engaged, sigma, current), side);
-                    ask = close.and(pushes);
-                }
-                let (side, ask) = (side.f(), ask.m());
-                for l in 0..chunk.len() {
-                    scratch.sides[(g * LANES + l) * m + slot] = if ask.0[l] != 0 {
-                        0
-                    } else if side.0[l] > 0.0 {
-                        1
-                    } else {
-                        -1
-                    };
+                    },
+                };
+                // Two pairs' alternating projections side by side: each round waits on
+                // the one before, so a second, independent chain keeps the processor
+                // busy meanwhile (the same operations per pair, so the same bits).
+                match waiting.take() {
+                    None => waiting = Some(pair),
+                    Some(mut first) => {
+                        let mut second = pair;
+                        project_together(&mut first, Some(&mut second));
+                        first.decide(sides, &mut scratch.sides, m, push_pull);
+                        second.decide(sides, &mut scratch.sides, m, push_pull);
+                    }
                 }
             }
+        }
+        if let Some(mut last) = waiting.take() {
+            project_together(&mut last, None);
+            last.decide(sides, &mut scratch.sides, m, push_pull);
         }
         let points = cloth.points.clone();
         scratch.dirty[points].iter_mut().for_each(|d| *d = false);
@@ -478,38 +469,42 @@ impl Pass<'_> {
                 // Every collider leaves a triangle without a free corner alone.
                 continue;
             }
-            let r = (rig.radius[i0] + rig.radius[i1] + rig.radius[i2]) / 3.0;
-            let corners = [self.pos[i0], self.pos[i1], self.pos[i2]];
             let sides = &mut sides[t * m..(t + 1) * m];
+            let r = || (rig.radius[i0] + rig.radius[i1] + rig.radius[i2]) / 3.0;
+            let corners = [self.pos[i0], self.pos[i1], self.pos[i2]];
             let (after, moved) = if scratch.dirty[i0] || scratch.dirty[i1] || scratch.dirty[i2] {
-                push_triangle_against(corners, free, r, cores, mode, sides)
+                push_triangle_against(corners, free, r(), cores, mode, sides)
             } else {
                 // A degenerate triangle is left alone by every collider.
                 let Some(frame) = scratch.frames[t] else {
                     continue;
                 };
-                let mut result = (corners, false);
+                // The lanes' answers up to the first pair that pushes.
+                let answers = &scratch.sides[t * m..(t + 1) * m];
+                let mut pushes = None;
                 for slot in 0..m {
                     if cores[slot].is_none() {
                         continue;
                     }
-                    match scratch.sides[t * m + slot] {
+                    match answers[slot] {
                         0 => {
-                            result = push_triangle_against_from(
-                                corners,
-                                Some(frame),
-                                free,
-                                r,
-                                &cores[slot..],
-                                mode,
-                                &mut sides[slot..],
-                            );
+                            pushes = Some(slot);
                             break;
                         }
                         side => sides[slot] = side,
                     }
                 }
-                result
+                // None pushes: the corners stay as they are.
+                let Some(slot) = pushes else { continue };
+                push_triangle_against_from(
+                    corners,
+                    Some(frame),
+                    free,
+                    r(),
+                    &cores[slot..],
+                    mode,
+                    &mut sides[slot..],
+                )
             };
             touched |= moved;
             for (corner, i) in after.into_iter().zip([i0, i1, i2]) {
@@ -520,6 +515,104 @@ impl Pass<'_> {
             }
         }
         touched
+    }
+}
+
+/// A triangle group and a core slot with some triangle near the core: what its
+/// alternating projections and decision need.
+struct ClosePair<T: Lane> {
+    /// Where the group's first triangle's slot is in the look-ahead's side array.
+    at: usize,
+    /// Triangles in the group.
+    len: usize,
+    corners: [V3<T>; 3],
+    normal: V3<T>,
+    ends: (V3<T>, V3<T>),
+    radius: T,
+    /// Lanes past the cheap reject (and not degenerate).
+    close: T::M,
+    /// The side memory the cheap reject learns.
+    side_far: T,
+    /// The closest points so far: on the core, on the triangle.
+    c: V3<T>,
+    q: V3<T>,
+    /// Lanes whose projections have not reached their fixed point.
+    going: T::M,
+}
+
+impl<T: Lane> ClosePair<T> {
+    /// One round of the alternating projections, in the lanes still going.
+    #[inline(always)]
+    fn project(&mut self) {
+        let [p0, p1, p2] = self.corners;
+        let next = closest_point_on_segment(self.q, self.ends.0, self.ends.1);
+        self.going = self.going.and(next.bits_eq(self.c).not());
+        self.c = V3::select(self.going, next, self.c);
+        let q = closest_point_on_triangle(self.c, p0, p1, p2);
+        self.q = V3::select(self.going, q, self.q);
+    }
+
+    /// The pair's decision from its closest points (`push_triangle_against`'s): the side
+    /// memory it leaves where it pushes nothing (±1), or 0 where the scalar code must do
+    /// it. `before` is the side memory as the pass found it.
+    #[inline(always)]
+    fn decide(&self, before: &[i8], out: &mut [i8], m: usize, push_pull: bool) {
+        let zero = T::splat(0.0);
+        let (one, minus_one) = (T::splat(1.0), T::splat(-1.0));
+        let (c, q, normal, radius) = (self.c, self.q, self.normal, self.radius);
+        let signed = normal.dot(c - self.corners[0]);
+        let dist = (c - q).length();
+        let off = c - normal * signed - q;
+        let over_face = off.dot(off).lt(T::splat(1e-10));
+        let current = T::select(zero.le(signed), one, minus_one);
+        let mut was = F([0.0; LANES]);
+        for l in 0..self.len {
+            was.0[l] = f32::from(before[self.at + l * m]);
+        }
+        let was = T::of(was);
+        let engaged = if push_pull {
+            over_face.and(signed.abs().lt(T::splat(2.0) * radius))
+        } else {
+            <T::M as Mask>::NONE
+        };
+        let sigma = T::select(was.ne(zero), was, current);
+        let violation = radius - sigma * signed;
+        // Pushes: engaged and `!(violation <= 0)`, else `!(dist > radius)`.
+        let pushes = engaged
+            .and(violation.le(zero).not())
+            .or(engaged.not().and(dist.gt(radius).not()));
+        let close = self.close;
+        let side = T::select(close, T::select(engaged, sigma, current), self.side_far);
+        let (side, ask) = (side.f(), close.and(pushes).m());
+        for l in 0..self.len {
+            out[self.at + l * m] = if ask.0[l] != 0 {
+                0
+            } else if side.0[l] > 0.0 {
+                1
+            } else {
+                -1
+            };
+        }
+    }
+}
+
+/// The alternating projections of `a` and `b` (if any) to their fixed points (at most 4
+/// rounds past the first), round by round together. A round in lanes no longer going
+/// changes nothing, so each pair ends as it would alone.
+#[inline(always)]
+fn project_together<T: Lane>(a: &mut ClosePair<T>, mut b: Option<&mut ClosePair<T>>) {
+    for _ in 0..4 {
+        let a_going = a.going.any();
+        let b_going = b.as_ref().is_some_and(|b| b.going.any());
+        if !a_going && !b_going {
+            break;
+        }
+        if a_going {
+            a.project();
+        }
+        if let (true, Some(b)) = (b_going, b.as_mut()) {
+            b.project();
+        }
     }
 }
 
