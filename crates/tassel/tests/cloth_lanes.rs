@@ -2,7 +2,8 @@
 //! cloth job (the readable reference): the same bits, frame after frame, where the cloth
 //! really meets its colliders: the built-in skirt through the demo, and a sheet that a
 //! ball, a bar, a box, a floor and a keep-inside limit push through every contact test
-//! (points, segments, both surface modes), with hitches, a pause and a jump.
+//! (points, segments, both surface modes), with hitches, a pause and a jump; and the
+//! angle limit, whose chains run side by side in lanes too.
 
 mod common;
 
@@ -238,13 +239,14 @@ fn sheet_rig(pairs: Vec<[String; 2]>, mode: SurfaceCollision, segments: bool) ->
 fn a_sheet_pushed_by_every_shape_gives_the_scalar_bits_in_lanes() {
     let (sk, pairs) = sheet();
     let mover = sk.find("mover").unwrap();
+    // The last item: the angle limit (degrees, 0 = off).
     let cases = [
-        (SurfaceCollision::PushPull, true),
-        (SurfaceCollision::Push, true),
-        (SurfaceCollision::Off, true),
-        (SurfaceCollision::PushPull, false),
+        (SurfaceCollision::PushPull, true, 0.0),
+        (SurfaceCollision::Push, true, 25.0),
+        (SurfaceCollision::Off, true, 0.0),
+        (SurfaceCollision::PushPull, false, 12.0),
     ];
-    for (mode, segments) in cases {
+    for (mode, segments, limit_angle) in cases {
         let run = |rig: &RigSettings| {
             assert_lanes_match(&sk, rig, 600, |f, locals| {
                 let t = f as f32 / 60.0;
@@ -263,8 +265,19 @@ fn a_sheet_pushed_by_every_shape_gives_the_scalar_bits_in_lanes() {
                 (component, common::dt_with_hitches(f))
             })
         };
-        let rig = sheet_rig(pairs.clone(), mode, segments);
+        let mut rig = sheet_rig(pairs.clone(), mode, segments);
+        rig.cloths[0].limit_angle = limit_angle;
         let with = run(&rig);
+        if limit_angle > 0.0 {
+            // The limit really turned segments back.
+            let mut free = rig.clone();
+            free.cloths[0].limit_angle = 0.0;
+            let gap = largest_gap(&with, &run(&free));
+            assert!(
+                gap > 0.01,
+                "{mode:?}: the angle limit moved the sheet by {gap} m at most"
+            );
+        }
         let mut bare = rig.clone();
         bare.cloths[0].colliders.clear();
         bare.colliders.clear();

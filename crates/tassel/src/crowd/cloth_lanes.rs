@@ -18,12 +18,15 @@
 //!   Where nothing touches (most of the time), nothing is left to the scalar code.
 
 use super::chain_step::{capsule_contact, sphere_contact, vmax, vmin};
-use super::lanes::{closest_point_on_segment, differs, Lane, Mask, F, LANES, M, V3};
+use super::lanes::{
+    acos_approx, closest_point_on_segment, differs, rotation_arc, Lane, Mask, F, LANES, M, V3,
+};
 use crate::collide::{PlacedCollider, Shape};
 use crate::dynamics::cloth::compile::ClothRig;
 use crate::dynamics::cloth::contact::{
     push_segment, push_triangle_against, push_triangle_against_from, Core, TriangleFrame,
 };
+use crate::dynamics::cloth::job::limit_angle_at;
 use crate::dynamics::cloth::SurfaceCollision;
 use crate::math::same_bits;
 use glam::Vec3;
@@ -85,6 +88,86 @@ pub(crate) fn collide(
     }
     let _ = avx2;
     pass.run::<F>()
+}
+
+/// The cloth job's `limit_angles`, one chain per lane, [`LANES`] chains side by side
+/// going down their points together: AVX2 where `avx2` allows it and the CPU has it,
+/// else the portable lane type. The lanes compute each segment's angle to its expected
+/// direction (the scalar operations, so the same bits); a segment past the limit is
+/// turned back by the scalar code, and its lane goes on from where that left the point.
+/// A chain's points are its own, so chains side by side give what one after another
+/// gives.
+pub(crate) fn limit_angles(
+    avx2: bool,
+    rig: &ClothRig,
+    ci: usize,
+    targets: &[Vec3],
+    pos: &mut [Vec3],
+) {
+    #[cfg(target_arch = "x86_64")]
+    if avx2 && std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: `limit_angles_avx2` only requires the AVX2 instructions, and the CPU
+        // was just checked to have them.
+        #[allow(unsafe_code)]
+        unsafe {
+            return limit_angles_avx2(rig, ci, targets, pos);
+        }
+    }
+    let _ = avx2;
+    limit_angles_in::<F>(rig, ci, targets, pos)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn limit_angles_avx2(rig: &ClothRig, ci: usize, targets: &[Vec3], pos: &mut [Vec3]) {
+    limit_angles_in::<Fa>(rig, ci, targets, pos)
+}
+
+#[inline(always)]
+fn limit_angles_in<T: Lane>(rig: &ClothRig, ci: usize, targets: &[Vec3], pos: &mut [Vec3]) {
+    let cloth = &rig.cloths[ci];
+    let limit = cloth.settings.limit_angle.to_radians();
+    for group in cloth.chains.chunks(LANES) {
+        // Point `k` of each chain of the group (lanes past a chain's end left at zero).
+        let gather = |k: usize, from: &[Vec3]| {
+            let mut v = V3::ZERO;
+            for (l, ch) in group.iter().enumerate() {
+                if ch.start + k < ch.end {
+                    v.set(l, from[ch.start + k]);
+                }
+            }
+            V3::<T>::of(v)
+        };
+        let longest = group.iter().map(|ch| ch.len()).max().unwrap_or(0);
+        let (mut t_parent, mut p_parent) = (gather(0, targets), gather(0, pos));
+        let (mut t_grand, mut p_grand) = (t_parent, p_parent);
+        for k in 1..longest {
+            let (t, mut p) = (gather(k, targets), gather(k, pos));
+            let anim = t - t_parent;
+            let expected = if k > 1 {
+                rotation_arc(t_parent - t_grand, p_parent - p_grand).mul_vec3(anim)
+            } else {
+                anim
+            };
+            let sim = p - p_parent;
+            // glam's `angle_between`; NaN is not past the limit.
+            let cos = expected.dot(sim) / (expected.dot(expected) * sim.dot(sim)).sqrt();
+            let over = acos_approx(cos).gt(T::splat(limit));
+            if over.any() {
+                let (over, mut pf) = (over.m(), p.f());
+                for (l, ch) in group.iter().enumerate() {
+                    let i = ch.start + k;
+                    if over.0[l] != 0 && i < ch.end && !rig.fixed[i] {
+                        limit_angle_at(ch.start, i, limit, targets, pos);
+                        pf.set(l, pos[i]);
+                    }
+                }
+                p = V3::of(pf);
+            }
+            (t_grand, t_parent) = (t_parent, t);
+            (p_grand, p_parent) = (p_parent, p);
+        }
+    }
 }
 
 /// A collider as the point pass asks it: where it is, its bounding radius (`None`: it

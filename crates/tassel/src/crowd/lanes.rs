@@ -965,7 +965,7 @@ impl F {
 /// constants as glam writes them.
 #[allow(clippy::approx_constant)]
 #[inline(always)]
-fn acos_approx<T: Lane>(v: T) -> T {
+pub(crate) fn acos_approx<T: Lane>(v: T) -> T {
     let nonnegative = T::splat(0.0).le(v);
     let x = v.abs();
     let omx = T::splat(1.0) - x;

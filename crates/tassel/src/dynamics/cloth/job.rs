@@ -460,7 +460,16 @@ fn step(rig: &ClothRig, ci: usize, state: &mut ClothState, h: f32, level: Option
         );
     }
     if s.limit_angle > 0.0 {
-        limit_angles(rig, ci, &state.step_targets, &mut state.pos);
+        match state.simd {
+            SimdUse::Scalar => limit_angles(rig, ci, &state.step_targets, &mut state.pos),
+            SimdUse::Portable | SimdUse::Auto => cloth_lanes::limit_angles(
+                state.simd == SimdUse::Auto,
+                rig,
+                ci,
+                &state.step_targets,
+                &mut state.pos,
+            ),
+        }
     }
     // Every step (not every frame, which would make the look depend on the frame rate):
     // no chain segment longer than at rest, without adding velocity.
@@ -671,24 +680,36 @@ fn limit_angles(rig: &ClothRig, ci: usize, targets: &[Vec3], pos: &mut [Vec3]) {
             if rig.fixed[p] {
                 continue;
             }
-            let parent = p - 1;
-            let anim = targets[p] - targets[parent];
-            let expected = if parent > ch.start {
-                let grand = parent - 1;
-                rotation_arc(targets[parent] - targets[grand], pos[parent] - pos[grand]) * anim
-            } else {
-                anim
-            };
-            let sim = pos[p] - pos[parent];
-            let angle = expected.angle_between(sim);
-            if angle.is_nan() || angle <= limit {
-                continue;
-            }
-            let axis = normalize_or(expected.cross(sim), expected.any_orthonormal_vector());
-            let dir = Quat::from_axis_angle(axis, limit) * normalize_or(expected, Vec3::NEG_Y);
-            pos[p] = pos[parent] + dir * sim.length();
+            limit_angle_at(ch.start, p, limit, targets, pos);
         }
     }
+}
+
+/// [`limit_angles`] for point `p` (not a chain's first, `start`) of a chain: turns its
+/// segment back to `limit` (radians) from the expected direction if it is farther.
+pub(crate) fn limit_angle_at(
+    start: usize,
+    p: usize,
+    limit: f32,
+    targets: &[Vec3],
+    pos: &mut [Vec3],
+) {
+    let parent = p - 1;
+    let anim = targets[p] - targets[parent];
+    let expected = if parent > start {
+        let grand = parent - 1;
+        rotation_arc(targets[parent] - targets[grand], pos[parent] - pos[grand]) * anim
+    } else {
+        anim
+    };
+    let sim = pos[p] - pos[parent];
+    let angle = expected.angle_between(sim);
+    if angle.is_nan() || angle <= limit {
+        return;
+    }
+    let axis = normalize_or(expected.cross(sim), expected.any_orthonormal_vector());
+    let dir = Quat::from_axis_angle(axis, limit) * normalize_or(expected, Vec3::NEG_Y);
+    pos[p] = pos[parent] + dir * sim.length();
 }
 
 /// Turns each cloth bone toward its simulated successor, on top of its animated rotation.

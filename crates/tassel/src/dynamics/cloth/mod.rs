@@ -11,7 +11,7 @@
 
 pub(crate) mod compile;
 pub(crate) mod contact;
-mod job;
+pub(crate) mod job;
 mod settings;
 
 pub use compile::{ClothConstraint, ClothRig, ConstraintKind};
