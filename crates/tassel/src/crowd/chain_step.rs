@@ -2,22 +2,23 @@
 //! pass, for [`LANES`] characters side by side. Each is
 //! [`crate::dynamics::chain::step`]'s and the chain job's output pass, operation for
 //! operation ([`super::lanes`] repeats glam's IEEE operations lane by lane), with every
-//! branch that depends on a character's state taken per lane (a mask). The broad phase,
+//! branch that depends on a character's state taken per lane (a mask). The cone limit,
+//! the broad phase,
 //! the colliders' quick rejection and, for keep-out spheres and capsules, the narrow
 //! phase's contact decision and its push of a point found inside run in lanes; a step
 //! that entered one of those (the swept contact) and every other shape are left to the
 //! scalar colliders, asked only for the lanes that need them.
 
 use super::lanes::{
-    closest_params_segment_segment, closest_point_on_segment, differs, Lane, Mask, F, LANES, M, Q,
-    V3,
+    acos_approx, closest_params_segment_segment, closest_point_on_segment, differs, Lane, Mask, F,
+    LANES, M, Q, V3,
 };
 use crate::collide::{PlacedCollider, Shape};
 use crate::dynamics::chain::compile::{ChainRig, NONE};
-use crate::dynamics::chain::step::{cone_limit, pull};
+use crate::dynamics::chain::step::pull;
 use crate::dynamics::chain::PlanarAxis;
 use crate::rng::SplitMix64;
-use glam::Vec3;
+use glam::{Quat, Vec3};
 
 /// A collider's broad-phase sphere per lane ([`PlacedCollider::bound_sphere`]): centre and
 /// radius with the collider's part of the margin; and for a capsule its axis ends.
@@ -458,15 +459,27 @@ pub(super) fn step_lanes<T: Lane>(
                 x = y;
                 let limit = rig.limit_angle[p];
                 if limit > 0.0 {
-                    let (mut xf, pf, af) = (x.f(), parent_pos.f(), anim_dir.f());
-                    for l in 0..LANES {
-                        if input.active.0[l] == 0 {
-                            continue;
-                        }
-                        let limited = cone_limit(xf.get(l), pf.get(l), af.get(l), limit);
-                        xf.set(l, limited);
+                    // `cone_limit` in lanes: the angle (glam's `angle_between`), and where
+                    // it is past the limit (a NaN angle is not) the point turned back onto
+                    // the cone, by the scalar function's operations.
+                    let d = x - parent_pos;
+                    let cos = d.dot(anim_dir) / (d.dot(d) * anim_dir.dot(anim_dir)).sqrt();
+                    let over = acos_approx(cos).gt(T::splat(limit)).and(active);
+                    if over.any() {
+                        // `Quat::from_axis_angle(axis, limit)` is `axis * sin, cos` of half
+                        // the limit, the same for every lane.
+                        let half = Quat::from_axis_angle(Vec3::X, limit);
+                        let (sin, cos) = (T::splat(half.x), T::splat(half.w));
+                        let axis = anim_dir.cross(d).normalize_or(anim_dir.any_orthonormal());
+                        let turn = Q {
+                            x: axis.x * sin,
+                            y: axis.y * sin,
+                            z: axis.z * sin,
+                            w: cos,
+                        };
+                        let limited = parent_pos + turn.mul_vec3(fallback) * d.length();
+                        x = V3::select(over, limited, x);
                     }
-                    x = V3::of(xf);
                 }
                 if s.planar_constraint != PlanarAxis::None {
                     let n = V3::<T>::of(input.normals[p]);
