@@ -3,11 +3,10 @@
 //! [`crate::dynamics::chain::step`]'s and the chain job's output pass, operation for
 //! operation ([`super::lanes`] repeats glam's IEEE operations lane by lane), with every
 //! branch that depends on a character's state taken per lane (a mask). The cone limit,
-//! the broad phase,
-//! the colliders' quick rejection and, for keep-out spheres and capsules, the narrow
-//! phase's contact decision and its push of a point found inside run in lanes; a step
-//! that entered one of those (the swept contact) and every other shape are left to the
-//! scalar colliders, asked only for the lanes that need them.
+//! the broad phase, the colliders' quick rejection and, for keep-out spheres and
+//! capsules, the narrow phase's contact decision and its push of a point found inside run
+//! in lanes; a step that entered one of those (the swept contact) and every other shape
+//! are left to the scalar colliders, asked only for the lanes that need them.
 
 use super::lanes::{
     acos_approx, closest_params_segment_segment, closest_point_on_segment, differs, Lane, Mask, F,
