@@ -19,17 +19,16 @@
 
 use super::chain_step::{capsule_contact, sphere_contact, vmax, vmin};
 use super::lanes::{
-    acos_approx, closest_point_on_segment, differs, rotation_arc, Lane, Mask, F, LANES, M, V3,
+    acos_approx, closest_point_on_segment, differs, rotation_arc, Lane, Mask, F, LANES, M, Q, V3,
 };
 use crate::collide::{PlacedCollider, Shape};
 use crate::dynamics::cloth::compile::ClothRig;
 use crate::dynamics::cloth::contact::{
     push_segment, push_triangle_against, push_triangle_against_from, Core, TriangleFrame,
 };
-use crate::dynamics::cloth::job::limit_angle_at;
 use crate::dynamics::cloth::SurfaceCollision;
 use crate::math::same_bits;
-use glam::Vec3;
+use glam::{Quat, Vec3};
 
 #[cfg(target_arch = "x86_64")]
 use super::avx::Fa;
@@ -93,10 +92,9 @@ pub(crate) fn collide(
 /// The cloth job's `limit_angles`, one chain per lane, [`LANES`] chains side by side
 /// going down their points together: AVX2 where `avx2` allows it and the CPU has it,
 /// else the portable lane type. The lanes compute each segment's angle to its expected
-/// direction (the scalar operations, so the same bits); a segment past the limit is
-/// turned back by the scalar code, and its lane goes on from where that left the point.
-/// A chain's points are its own, so chains side by side give what one after another
-/// gives.
+/// direction and, for a segment past the limit, its turn back (the scalar operations, so
+/// the same bits). A chain's points are its own, so chains side by side give what one
+/// after another gives.
 pub(crate) fn limit_angles(
     avx2: bool,
     rig: &ClothRig,
@@ -153,16 +151,35 @@ fn limit_angles_in<T: Lane>(rig: &ClothRig, ci: usize, targets: &[Vec3], pos: &m
             // glam's `angle_between`; NaN is not past the limit.
             let cos = expected.dot(sim) / (expected.dot(expected) * sim.dot(sim)).sqrt();
             let over = acos_approx(cos).gt(T::splat(limit));
+            // Lanes of free points of the group's chains.
+            let mut free = M::NONE;
+            for (l, ch) in group.iter().enumerate() {
+                let i = ch.start + k;
+                if i < ch.end && !rig.fixed[i] {
+                    free.0[l] = !0;
+                }
+            }
+            let over = over.and(<T::M as Mask>::of(free));
             if over.any() {
-                let (over, mut pf) = (over.m(), p.f());
+                // `limit_angle_at`'s turn back onto the cone: `Quat::from_axis_angle(axis,
+                // limit)` is `axis * sin, cos` of half the limit, the same in every lane.
+                let half = Quat::from_axis_angle(Vec3::X, limit);
+                let (sin, cos) = (T::splat(half.x), T::splat(half.w));
+                let axis = expected.cross(sim).normalize_or(expected.any_orthonormal());
+                let turn = Q {
+                    x: axis.x * sin,
+                    y: axis.y * sin,
+                    z: axis.z * sin,
+                    w: cos,
+                };
+                let dir = turn.mul_vec3(expected.normalize_or(V3::splat(Vec3::NEG_Y)));
+                p = V3::select(over, p_parent + dir * sim.length(), p);
+                let (over, pf) = (over.m(), p.f());
                 for (l, ch) in group.iter().enumerate() {
-                    let i = ch.start + k;
-                    if over.0[l] != 0 && i < ch.end && !rig.fixed[i] {
-                        limit_angle_at(ch.start, i, limit, targets, pos);
-                        pf.set(l, pos[i]);
+                    if over.0[l] != 0 {
+                        pos[ch.start + k] = pf.get(l);
                     }
                 }
-                p = V3::of(pf);
             }
             (t_grand, t_parent) = (t_parent, t);
             (p_grand, p_parent) = (p_parent, p);

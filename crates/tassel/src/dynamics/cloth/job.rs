@@ -687,13 +687,7 @@ fn limit_angles(rig: &ClothRig, ci: usize, targets: &[Vec3], pos: &mut [Vec3]) {
 
 /// [`limit_angles`] for point `p` (not a chain's first, `start`) of a chain: turns its
 /// segment back to `limit` (radians) from the expected direction if it is farther.
-pub(crate) fn limit_angle_at(
-    start: usize,
-    p: usize,
-    limit: f32,
-    targets: &[Vec3],
-    pos: &mut [Vec3],
-) {
+fn limit_angle_at(start: usize, p: usize, limit: f32, targets: &[Vec3], pos: &mut [Vec3]) {
     let parent = p - 1;
     let anim = targets[p] - targets[parent];
     let expected = if parent > start {

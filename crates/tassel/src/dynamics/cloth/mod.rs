@@ -11,7 +11,7 @@
 
 pub(crate) mod compile;
 pub(crate) mod contact;
-pub(crate) mod job;
+mod job;
 mod settings;
 
 pub use compile::{ClothConstraint, ClothRig, ConstraintKind};
