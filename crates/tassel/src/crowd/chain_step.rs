@@ -9,15 +9,15 @@
 //! are left to the scalar colliders, asked only for the lanes that need them.
 
 use super::lanes::{
-    acos_approx, closest_params_segment_segment, closest_point_on_segment, differs, Lane, Mask, F,
-    LANES, M, Q, V3,
+    angle_between, closest_params_segment_segment, closest_point_on_segment, differs,
+    turned_toward, Lane, Mask, F, LANES, M, Q, V3,
 };
 use crate::collide::{PlacedCollider, Shape};
 use crate::dynamics::chain::compile::{ChainRig, NONE};
 use crate::dynamics::chain::step::pull;
 use crate::dynamics::chain::PlanarAxis;
 use crate::rng::SplitMix64;
-use glam::{Quat, Vec3};
+use glam::Vec3;
 
 /// A collider's broad-phase sphere per lane ([`PlacedCollider::bound_sphere`]): centre and
 /// radius with the collider's part of the margin; and for a capsule its axis ends.
@@ -458,26 +458,14 @@ pub(super) fn step_lanes<T: Lane>(
                 x = y;
                 let limit = rig.limit_angle[p];
                 if limit > 0.0 {
-                    // `cone_limit` in lanes: the angle (glam's `angle_between`), and where
-                    // it is past the limit (a NaN angle is not) the point turned back onto
-                    // the cone, by the scalar function's operations.
+                    // `cone_limit` in lanes: the angle, and where it is past the limit (a
+                    // NaN angle is not) the point turned back onto the cone, by the scalar
+                    // function's operations.
                     let d = x - parent_pos;
-                    let cos = d.dot(anim_dir) / (d.dot(d) * anim_dir.dot(anim_dir)).sqrt();
-                    let over = acos_approx(cos).gt(T::splat(limit)).and(active);
+                    let over = angle_between(d, anim_dir).gt(T::splat(limit)).and(active);
                     if over.any() {
-                        // `Quat::from_axis_angle(axis, limit)` is `axis * sin, cos` of half
-                        // the limit, the same for every lane.
-                        let half = Quat::from_axis_angle(Vec3::X, limit);
-                        let (sin, cos) = (T::splat(half.x), T::splat(half.w));
-                        let axis = anim_dir.cross(d).normalize_or(anim_dir.any_orthonormal());
-                        let turn = Q {
-                            x: axis.x * sin,
-                            y: axis.y * sin,
-                            z: axis.z * sin,
-                            w: cos,
-                        };
-                        let limited = parent_pos + turn.mul_vec3(fallback) * d.length();
-                        x = V3::select(over, limited, x);
+                        let dir = turned_toward(anim_dir, d, fallback, limit);
+                        x = V3::select(over, parent_pos + dir * d.length(), x);
                     }
                 }
                 if s.planar_constraint != PlanarAxis::None {

@@ -19,7 +19,8 @@
 
 use super::chain_step::{capsule_contact, sphere_contact, vmax, vmin};
 use super::lanes::{
-    acos_approx, closest_point_on_segment, differs, rotation_arc, Lane, Mask, F, LANES, M, Q, V3,
+    angle_between, closest_point_on_segment, differs, rotation_arc, turned_toward, Lane, Mask, F,
+    LANES, M, V3,
 };
 use crate::collide::{PlacedCollider, Shape};
 use crate::dynamics::cloth::compile::ClothRig;
@@ -28,7 +29,7 @@ use crate::dynamics::cloth::contact::{
 };
 use crate::dynamics::cloth::SurfaceCollision;
 use crate::math::same_bits;
-use glam::{Quat, Vec3};
+use glam::Vec3;
 
 #[cfg(target_arch = "x86_64")]
 use super::avx::Fa;
@@ -148,9 +149,8 @@ fn limit_angles_in<T: Lane>(rig: &ClothRig, ci: usize, targets: &[Vec3], pos: &m
                 anim
             };
             let sim = p - p_parent;
-            // glam's `angle_between`; NaN is not past the limit.
-            let cos = expected.dot(sim) / (expected.dot(expected) * sim.dot(sim)).sqrt();
-            let over = acos_approx(cos).gt(T::splat(limit));
+            // NaN is not past the limit.
+            let over = angle_between(expected, sim).gt(T::splat(limit));
             // Lanes of free points of the group's chains.
             let mut free = M::NONE;
             for (l, ch) in group.iter().enumerate() {
@@ -161,18 +161,9 @@ fn limit_angles_in<T: Lane>(rig: &ClothRig, ci: usize, targets: &[Vec3], pos: &m
             }
             let over = over.and(<T::M as Mask>::of(free));
             if over.any() {
-                // `limit_angle_at`'s turn back onto the cone: `Quat::from_axis_angle(axis,
-                // limit)` is `axis * sin, cos` of half the limit, the same in every lane.
-                let half = Quat::from_axis_angle(Vec3::X, limit);
-                let (sin, cos) = (T::splat(half.x), T::splat(half.w));
-                let axis = expected.cross(sim).normalize_or(expected.any_orthonormal());
-                let turn = Q {
-                    x: axis.x * sin,
-                    y: axis.y * sin,
-                    z: axis.z * sin,
-                    w: cos,
-                };
-                let dir = turn.mul_vec3(expected.normalize_or(V3::splat(Vec3::NEG_Y)));
+                // `limit_angle_at`'s turn back onto the cone.
+                let unit = expected.normalize_or(V3::splat(Vec3::NEG_Y));
+                let dir = turned_toward(expected, sim, unit, limit);
                 p = V3::select(over, p_parent + dir * sim.length(), p);
                 let (over, pf) = (over.m(), p.f());
                 for (l, ch) in group.iter().enumerate() {

@@ -965,7 +965,7 @@ impl F {
 /// constants as glam writes them.
 #[allow(clippy::approx_constant)]
 #[inline(always)]
-pub(crate) fn acos_approx<T: Lane>(v: T) -> T {
+fn acos_approx<T: Lane>(v: T) -> T {
     let nonnegative = T::splat(0.0).le(v);
     let x = v.abs();
     let omx = T::splat(1.0) - x;
@@ -981,6 +981,37 @@ pub(crate) fn acos_approx<T: Lane>(v: T) -> T {
     let result = r * x + c(1.570_796_3);
     let result = result * root;
     T::select(nonnegative, result, c(std::f32::consts::PI) - result)
+}
+
+/// glam's `Vec3::angle_between` per lane (its `acos` approximation included).
+#[inline(always)]
+pub(crate) fn angle_between<T: Lane>(a: V3<T>, b: V3<T>) -> T {
+    acos_approx(a.dot(b) / (a.dot(a) * b.dot(b)).sqrt())
+}
+
+/// The direction `limit` radians (the same in every lane) from `from`, turned toward
+/// `toward`, as the scalar cone limits compute it: `Quat::from_axis_angle(normalize_or(from
+/// × toward, from.any_orthonormal_vector()), limit) * unit_from`, where `unit_from` is
+/// `from` normalised with the caller's fallback.
+#[inline(always)]
+pub(crate) fn turned_toward<T: Lane>(
+    from: V3<T>,
+    toward: V3<T>,
+    unit_from: V3<T>,
+    limit: f32,
+) -> V3<T> {
+    // `Quat::from_axis_angle(axis, limit)` is `axis * sin, cos` of half the limit: the
+    // scalar function's own sine and cosine, read from its quaternion about X.
+    let half = Quat::from_axis_angle(Vec3::X, limit);
+    let (sin, cos) = (T::splat(half.x), T::splat(half.w));
+    let axis = from.cross(toward).normalize_or(from.any_orthonormal());
+    let turn = Q {
+        x: axis.x * sin,
+        y: axis.y * sin,
+        z: axis.z * sin,
+        w: cos,
+    };
+    turn.mul_vec3(unit_from)
 }
 
 /// glam's SSE2 `m128_sin` (DirectXMath's 11th-degree minimax after reduction to
