@@ -15,10 +15,10 @@
 //! **Soundness.** The intrinsics need AVX. [`Fa`] and [`Ma`] are private to the crowd and
 //! only ever created inside functions compiled with `#[target_feature(enable = "avx2")]`
 //! that are called after `is_x86_feature_detected!("avx2")` said yes (`Ctx::run` in
-//! `vrm.rs`, `Ctx::step` and `Ctx::model_pose` in `chain.rs`, `Pass::run_avx2` in
-//! `cloth_lanes.rs`; the tests below check the same first), so no AVX instruction runs
-//! on a CPU without it. The operations are `#[inline(always)]` so that they are compiled
-//! inside those functions.
+//! `vrm.rs`, `Ctx::step` and `Ctx::model_pose` in `chain.rs`, `Pass::run_avx2` and
+//! `limit_angles_avx2` in `cloth_lanes.rs`; the tests below check the same first), so no
+//! AVX instruction runs on a CPU without it. The operations are `#[inline(always)]` so
+//! that they are compiled inside those functions.
 #![allow(unsafe_code)]
 
 use super::lanes::{Lane, Mask, F, M};

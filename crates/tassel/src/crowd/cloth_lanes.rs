@@ -1,6 +1,7 @@
-//! One character's bone cloth with its contact tests in SIMD lanes: the cloth job's
-//! `collide` (points, structural segments and quad triangles against the cloth's
-//! colliders), giving the scalar function's bits.
+//! One character's bone cloth with its contact tests and its angle limit in SIMD lanes:
+//! the cloth job's `collide` (points, structural segments and quad triangles against the
+//! cloth's colliders) and `limit_angles` (the chains side by side, one per lane), giving
+//! the scalar functions' bits.
 //!
 //! - **Points**: a point's answer depends on that point alone, so [`LANES`] points go side
 //!   by side through every collider in order: the collider's quick rejection and, for
@@ -161,7 +162,7 @@ fn limit_angles_in<T: Lane>(rig: &ClothRig, ci: usize, targets: &[Vec3], pos: &m
             }
             let over = over.and(<T::M as Mask>::of(free));
             if over.any() {
-                // `limit_angle_at`'s turn back onto the cone.
+                // The scalar `limit_angles`' turn back onto the cone.
                 let unit = expected.normalize_or(V3::splat(Vec3::NEG_Y));
                 let dir = turned_toward(expected, sim, unit, limit);
                 p = V3::select(over, p_parent + dir * sim.length(), p);

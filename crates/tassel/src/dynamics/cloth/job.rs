@@ -680,30 +680,24 @@ fn limit_angles(rig: &ClothRig, ci: usize, targets: &[Vec3], pos: &mut [Vec3]) {
             if rig.fixed[p] {
                 continue;
             }
-            limit_angle_at(ch.start, p, limit, targets, pos);
+            let parent = p - 1;
+            let anim = targets[p] - targets[parent];
+            let expected = if parent > ch.start {
+                let grand = parent - 1;
+                rotation_arc(targets[parent] - targets[grand], pos[parent] - pos[grand]) * anim
+            } else {
+                anim
+            };
+            let sim = pos[p] - pos[parent];
+            let angle = expected.angle_between(sim);
+            if angle.is_nan() || angle <= limit {
+                continue;
+            }
+            let axis = normalize_or(expected.cross(sim), expected.any_orthonormal_vector());
+            let dir = Quat::from_axis_angle(axis, limit) * normalize_or(expected, Vec3::NEG_Y);
+            pos[p] = pos[parent] + dir * sim.length();
         }
     }
-}
-
-/// [`limit_angles`] for point `p` (not a chain's first, `start`) of a chain: turns its
-/// segment back to `limit` (radians) from the expected direction if it is farther.
-fn limit_angle_at(start: usize, p: usize, limit: f32, targets: &[Vec3], pos: &mut [Vec3]) {
-    let parent = p - 1;
-    let anim = targets[p] - targets[parent];
-    let expected = if parent > start {
-        let grand = parent - 1;
-        rotation_arc(targets[parent] - targets[grand], pos[parent] - pos[grand]) * anim
-    } else {
-        anim
-    };
-    let sim = pos[p] - pos[parent];
-    let angle = expected.angle_between(sim);
-    if angle.is_nan() || angle <= limit {
-        return;
-    }
-    let axis = normalize_or(expected.cross(sim), expected.any_orthonormal_vector());
-    let dir = Quat::from_axis_angle(axis, limit) * normalize_or(expected, Vec3::NEG_Y);
-    pos[p] = pos[parent] + dir * sim.length();
 }
 
 /// Turns each cloth bone toward its simulated successor, on top of its animated rotation.
