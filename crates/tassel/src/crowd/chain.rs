@@ -212,6 +212,8 @@ struct Scratch {
     /// The model pose per joint, all lanes side by side (computed in lanes, then copied
     /// into `models`).
     lane_models: Vec<Trs>,
+    /// The animated local rotation per joint, all lanes side by side.
+    lane_local_rotations: Vec<Q>,
     component: Trs,
     /// This frame's animated targets and planar normals per point, colliders lane after
     /// lane, and the colliders' broad-phase spheres.
@@ -248,6 +250,7 @@ impl Scratch {
             locals: vec![Transform::IDENTITY; joints * LANES],
             models: vec![Transform::IDENTITY; joints * LANES],
             lane_models: vec![Trs::splat(&Transform::IDENTITY); joints],
+            lane_local_rotations: vec![Q::splat(Quat::IDENTITY); joints],
             component: Trs::splat(&Transform::IDENTITY),
             targets: vec![zero; n],
             normals: vec![V3::splat(Vec3::Y); n],
@@ -818,6 +821,7 @@ fn model_pose_lanes<T: Lane>(sk: &Skeleton, s: &mut Scratch, count: usize) {
         for l in 0..count {
             local.set(l, &s.locals[l * n + j]);
         }
+        s.lane_local_rotations[j] = local.r;
         let local = Trs::<T>::of(&local);
         let model = match sk.parent(j) {
             Some(p) => Trs::<T>::of(&s.lane_models[p]).mul(&local),
@@ -984,13 +988,12 @@ impl Ctx<'_> {
     #[inline(always)]
     fn write_back(&self, pack: &mut Pack, s: &mut Scratch) {
         let (sk, rig) = (self.sk, self.rig);
-        let n = sk.len();
+        // The animated model rotations (in the lanes not in use: of identity locals,
+        // never read).
         for &(j, _, _) in &rig.rotators {
             let j = j as usize;
             for k in std::iter::once(j).chain(sk.parent(j)) {
-                for l in 0..pack.count {
-                    s.rotations[k].set(l, s.models[l * n + k].rotation);
-                }
+                s.rotations[k] = s.lane_models[k].r;
             }
         }
         let zero = V3::splat(Vec3::ZERO);
@@ -1010,10 +1013,7 @@ impl Ctx<'_> {
                 None => Q::splat(Quat::IDENTITY),
             };
             let local = parent_rot.conjugate().mul_quat(new_rot).normalize();
-            let mut animated = Q::splat(Quat::IDENTITY);
-            for l in 0..pack.count {
-                animated.set(l, s.locals[l * n + j].rotation);
-            }
+            let animated = s.lane_local_rotations[j];
             pack.out_rotation[k] = Q::select(skip, animated, local);
             s.rotations[j] = Q::select(skip, s.rotations[j], new_rot);
         }

@@ -8,6 +8,7 @@
 //! in lanes; a step that entered one of those (the swept contact) and every other shape
 //! are left to the scalar colliders, asked only for the lanes that need them.
 
+use super::entry_lanes::{capsule_entry_push, sphere_entry};
 use super::lanes::{
     angle_between, closest_params_segment_segment, closest_point_on_segment, differs,
     turned_toward, Lane, Mask, F, LANES, M, Q, V3,
@@ -144,7 +145,7 @@ pub(super) fn sphere_contact<T: Lane>(
 /// [`crate::collide::entry_radius`] per lane: `limit` less the contact tolerance (1e-4 of it), never
 /// below 0, with the scalar function's operations.
 #[inline(always)]
-fn entry_radius_lanes<T: Lane>(limit: T) -> T {
+pub(super) fn entry_radius_lanes<T: Lane>(limit: T) -> T {
     (limit - T::splat(1e-4) * limit).max(T::splat(0.0))
 }
 
@@ -324,15 +325,19 @@ fn collide<T: Lane>(
         // Keep-out spheres and capsules: the lanes asked that the step did not enter get
         // their point from the lanes' own narrow phase; the rest (entries, other shapes)
         // from the scalar one.
+        let (a, b) = (V3::of(bound.a), V3::of(bound.b));
         let contact = match shape.decision {
-            Decision::Sphere(radius) => Some(sphere_contact(y, q, bc, T::splat(radius + r))),
+            Decision::Sphere(radius) => {
+                let limit = T::splat(radius + r);
+                Some((sphere_contact(y, q, bc, limit), limit, false))
+            }
             Decision::Capsule(radius) => {
-                let (a, b) = (V3::of(bound.a), V3::of(bound.b));
-                Some(capsule_contact(y, q, a, b, T::splat(radius + r)))
+                let limit = T::splat(radius + r);
+                Some((capsule_contact(y, q, a, b, limit), limit, true))
             }
             Decision::Scalar => None,
         };
-        if let Some(contact) = contact {
+        if let Some((contact, limit, capsule)) = contact {
             ask = ask.and(contact.may);
             let pushed = ask.and(contact.entered.not());
             if pushed.any() {
@@ -340,6 +345,20 @@ fn collide<T: Lane>(
                 moved = pushed.and(differs(y, x)).or(pushed.not().and(moved));
             }
             ask = ask.and(contact.entered);
+            if !ask.any() {
+                continue;
+            }
+            // The entries: in lanes too, but for a capsule's graze whose closed form
+            // found no root (the scalar narrow phase bisects there).
+            let (entry, hard) = if capsule {
+                capsule_entry_push(y, q, a, b, limit)
+            } else {
+                (sphere_entry(y, q, bc, limit), <T::M as Mask>::NONE)
+            };
+            let slid = ask.and(hard.not());
+            y = V3::select(slid, entry, y);
+            moved = slid.and(differs(y, x)).or(slid.not().and(moved));
+            ask = ask.and(hard);
             if !ask.any() {
                 continue;
             }
@@ -571,15 +590,18 @@ mod tests {
 
     /// The lanes' contact for keep-out spheres and capsules gives the scalar narrow
     /// phase's bits: a lane it turns away gets its point back from the scalar narrow
-    /// phase unchanged, and a lane it pushes without an entry gets the point the scalar
-    /// narrow phase gives. Steps start and end inside, on and outside the shapes, graze
-    /// them and pass through them; every answer must occur often (a decision that always
-    /// asks, or never, fails). In `F` and, where the CPU has it, in the AVX lane type.
+    /// phase unchanged, a lane it pushes without an entry gets the point the scalar
+    /// narrow phase gives, and so does a lane whose step entered the shape (the swept
+    /// entry of `entry_lanes`, but for the capsule lanes it reports `hard`). Steps start
+    /// and end inside, on and outside the shapes, graze them and pass through them; every
+    /// answer must occur often (a decision that always asks, or never, fails). In `F` and,
+    /// where the CPU has it, in the AVX lane type.
     #[test]
     fn lane_contact_gives_the_narrow_phase_bits() {
         let mut rng = SplitMix64::new(5);
         let mut u = |lo: f32, hi: f32| rng.range_f32(lo, hi);
         let (mut kept, mut asked, mut moved, mut entries) = (0, 0, 0, 0);
+        let (mut sphere_entries, mut capsule_entries, mut hard_entries) = (0, 0, 0);
         let bits = |v: V3| [v.x, v.y, v.z].map(|c| c.0.map(f32::to_bits));
         for round in 0..3000 {
             let capsule = round % 2 == 1;
@@ -609,13 +631,25 @@ mod tests {
                 // Points at a distance around the shape's reach, some exactly on it.
                 let reach = limit + 0.5 * length;
                 let dir = Vec3::new(u(-1.0, 1.0), u(-1.0, 1.0), u(-1.0, 1.0)).normalize_or(Vec3::X);
-                let from = centre + dir * u(0.0, 2.0 * reach);
-                let to = match (round + l) % 5 {
+                let mut from = centre + dir * u(0.0, 2.0 * reach);
+                let to = match (round + l) % 6 {
                     0 => from,
                     1 => centre - dir * u(0.0, 2.0 * reach),
                     2 => from + Vec3::new(u(-0.05, 0.05), u(-0.05, 0.05), u(-0.05, 0.05)),
                     // On the centre (the axis): the push takes the fallback direction.
                     3 => centre,
+                    // A graze of the entry surface: past a point at about its distance
+                    // from the centre (the axis), across or along the axis.
+                    4 => {
+                        let axis = (bound.b.get(0) - bound.a.get(0)).normalize_or(Vec3::Y);
+                        let e = axis.any_orthonormal_vector();
+                        let inner = (limit - 1e-4 * limit) * (1.0 + u(-1e-6, 1e-6));
+                        let w = if l % 2 == 0 { axis } else { axis.cross(e) };
+                        let g = centre + e * inner;
+                        let k = u(0.01, 0.2);
+                        from = g - w * k;
+                        g + w * k * u(0.5, 1.5)
+                    }
                     _ => centre + (from - centre).normalize_or(Vec3::Y) * limit,
                 };
                 p.set(l, to);
@@ -630,6 +664,11 @@ mod tests {
                 sphere_contact(p, q, c, F::splat(limit))
             };
             let (may, entered, pushed) = (contact.may, contact.entered, contact.pushed);
+            let (entry, hard) = if capsule {
+                capsule_entry_push(p, q, a, b, F::splat(limit))
+            } else {
+                (sphere_entry(p, q, c, F::splat(limit)), M::NONE)
+            };
             #[cfg(target_arch = "x86_64")]
             if std::is_x86_feature_detected!("avx2") {
                 // SAFETY: the CPU has AVX2 (checked just above).
@@ -638,6 +677,8 @@ mod tests {
                 assert_eq!(avx.0, may, "round {round}: AVX decision");
                 assert_eq!(avx.1, entered, "round {round}: AVX entry");
                 assert_eq!(bits(avx.2), bits(pushed), "round {round}: AVX push");
+                assert_eq!(bits(avx.3), bits(entry), "round {round}: AVX entry point");
+                assert_eq!(avx.4, hard, "round {round}: AVX hard entries");
             }
             for l in 0..LANES {
                 let want = if capsule {
@@ -655,6 +696,20 @@ mod tests {
                     kept += 1;
                 } else if entered.0[l] != 0 {
                     entries += 1;
+                    if hard.0[l] != 0 {
+                        hard_entries += 1;
+                        continue;
+                    }
+                    assert_eq!(
+                        bits_of(entry.get(l)),
+                        bits_of(want),
+                        "round {round} lane {l}: entry in lanes"
+                    );
+                    if capsule {
+                        capsule_entries += 1;
+                    } else {
+                        sphere_entries += 1;
+                    }
                 } else {
                     assert_eq!(
                         bits_of(pushed.get(l)),
@@ -670,19 +725,44 @@ mod tests {
             kept > 2000 && asked > 2000 && moved > 1000 && entries > 1000,
             "{kept} {asked} {moved} {entries}"
         );
+        // Grazes the closed form cannot answer occur (the generator makes some) and are
+        // rare: most entries are answered.
+        assert!(
+            sphere_entries > 400
+                && capsule_entries > 400
+                && hard_entries > 0
+                && hard_entries * 50 < entries,
+            "{sphere_entries} {capsule_entries} {hard_entries} of {entries}"
+        );
     }
 
     /// [`capsule_contact`] or [`sphere_contact`] in the AVX lane type, back in `F`/`M`.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    fn contact_avx2(capsule: bool, p: V3, q: V3, a: V3, b: V3, c: V3, limit: f32) -> (M, M, V3) {
+    #[allow(clippy::too_many_arguments)]
+    fn contact_avx2(
+        capsule: bool,
+        p: V3,
+        q: V3,
+        a: V3,
+        b: V3,
+        c: V3,
+        limit: f32,
+    ) -> (M, M, V3, V3, M) {
         use crate::crowd::avx::Fa;
         let (p, q) = (V3::<Fa>::of(p), V3::<Fa>::of(q));
-        let k = if capsule {
-            capsule_contact(p, q, V3::of(a), V3::of(b), Fa::splat(limit))
+        let (a, b, c, limit) = (V3::of(a), V3::of(b), V3::of(c), Fa::splat(limit));
+        let (k, (entry, hard)) = if capsule {
+            (
+                capsule_contact(p, q, a, b, limit),
+                capsule_entry_push(p, q, a, b, limit),
+            )
         } else {
-            sphere_contact(p, q, V3::of(c), Fa::splat(limit))
+            (
+                sphere_contact(p, q, c, limit),
+                (sphere_entry(p, q, c, limit), <Fa as Lane>::M::NONE),
+            )
         };
-        (k.may.m(), k.entered.m(), k.pushed.f())
+        (k.may.m(), k.entered.m(), k.pushed.f(), entry.f(), hard.m())
     }
 }

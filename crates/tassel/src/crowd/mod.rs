@@ -16,6 +16,7 @@ mod chain;
 pub(crate) mod chain_lanes;
 mod chain_step;
 pub(crate) mod cloth_lanes;
+mod entry_lanes;
 pub mod lanes;
 pub(crate) mod spring_lanes;
 mod vrm;
