@@ -81,6 +81,15 @@ impl D {
             }
         }))
     }
+    /// `f64::min` per lane.
+    #[inline(always)]
+    fn min(self, o: D) -> D {
+        let mut r = [0.0f64; LANES];
+        for i in 0..LANES {
+            r[i] = self.0[i].min(o.0[i]);
+        }
+        D(r)
+    }
     #[inline(always)]
     fn select(m: M, a: D, b: D) -> D {
         D(std::array::from_fn(|i| {
@@ -170,18 +179,20 @@ fn capsule_entry(o: V3, v: V3, a: V3, b: V3, rho: F) -> (F, M) {
     let (o, v, a, b) = (D3::of(o), D3::of(v), D3::of(a), D3::of(b));
     let rho2 = D::of(rho) * D::of(rho);
     let vv = v.dot(v);
-    let ball = |c: D3| {
+    // An end ball at `c`: |o − c + v·t|² = ρ².
+    #[inline(always)]
+    fn ball(o: D3, v: D3, vv: D, c: D3, rho2: D) -> (D, M) {
         let oc = o.sub(c);
         entry_root(vv, v.dot(oc), oc.dot(oc) - rho2)
-    };
-    let min = |a: D, b: D| D(std::array::from_fn(|i| a.0[i].min(b.0[i])));
+    }
+    let min = D::min;
     let mut first = D::splat(f64::INFINITY);
-    let (t, found) = ball(a);
+    let (t, found) = ball(o, v, vv, a, rho2);
     first = D::select(found, min(first, t), first);
     let ba = b.sub(a);
     let baba = ba.dot(ba);
     let long = baba.test(D::splat(1e-20), |a, b| a > b);
-    let (t, found) = ball(b);
+    let (t, found) = ball(o, v, vv, b, rho2);
     first = D::select(long.and(found), min(first, t), first);
     // The infinite cylinder, from the parts of the start and the step across the axis.
     let n = ba.div(baba.map(f64::sqrt));
