@@ -16,7 +16,8 @@
 //! only ever created inside functions compiled with `#[target_feature(enable = "avx2")]`
 //! that are called after `is_x86_feature_detected!("avx2")` said yes (`Ctx::run` in
 //! `vrm.rs`, `Ctx::step` and `Ctx::model_pose` in `chain.rs`, `Pass::run_avx2` and
-//! `limit_angles_avx2` in `cloth_lanes.rs`; the tests below check the same first), so no
+//! `limit_angles_avx2` in `cloth_lanes.rs`; `entry_avx2` in `entry_lanes.rs`, called only
+//! where an [`Fa`] exists already; the tests below check the same first), so no
 //! AVX instruction runs on a CPU without it. The operations are `#[inline(always)]` so
 //! that they are compiled inside those functions.
 #![allow(unsafe_code)]
@@ -70,6 +71,7 @@ impl Neg for Fa {
 
 impl Lane for Fa {
     type M = Ma;
+    const AVX: bool = true;
     #[inline(always)]
     fn splat(v: f32) -> Fa {
         // SAFETY: see the module's documentation.

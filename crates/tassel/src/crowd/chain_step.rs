@@ -8,7 +8,7 @@
 //! in lanes; a step that entered one of those (the swept contact) and every other shape
 //! are left to the scalar colliders, asked only for the lanes that need them.
 
-use super::entry_lanes::{capsule_entry_push, sphere_entry};
+use super::entry_lanes::entry;
 use super::lanes::{
     angle_between, closest_params_segment_segment, closest_point_on_segment, differs,
     turned_toward, Lane, Mask, F, LANES, M, Q, V3,
@@ -350,11 +350,7 @@ fn collide<T: Lane>(
             }
             // The entries: in lanes too, but for a capsule's graze whose closed form
             // found no root (the scalar narrow phase bisects there).
-            let (entry, hard) = if capsule {
-                capsule_entry_push(y, q, a, b, limit)
-            } else {
-                (sphere_entry(y, q, bc, limit), <T::M as Mask>::NONE)
-            };
+            let (entry, hard) = entry(capsule, y, q, bc, a, b, limit, ask);
             let slid = ask.and(hard.not());
             y = V3::select(slid, entry, y);
             moved = slid.and(differs(y, x)).or(slid.not().and(moved));
@@ -585,6 +581,7 @@ pub(super) fn output_lanes<T: Lane>(
 mod tests {
     use super::*;
     use crate::collide::{push_out_of_capsule, push_out_of_sphere};
+    use crate::crowd::entry_lanes::{capsule_entry_push, sphere_entry};
     use crate::math::Transform;
     use glam::Quat;
 

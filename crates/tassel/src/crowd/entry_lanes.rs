@@ -8,7 +8,13 @@
 //! per-lane loops the compiler vectorises). A lane whose closed form finds no root (a
 //! graze lost to rounding, where the scalar function bisects) is reported `hard` and left
 //! to the scalar narrow phase.
+//!
+//! [`entry`] runs them out of line (in AVX2 where the caller's lane type is the AVX one):
+//! inlined into every copy of the solver step, their `f64` code tripled the crate's
+//! release build time.
 
+#[cfg(target_arch = "x86_64")]
+use super::avx::Fa;
 use super::chain_step::entry_radius_lanes;
 use super::lanes::{closest_params_segment_segment, closest_point_on_segment, Lane, F, LANES};
 use super::lanes::{Mask, M, V3};
@@ -298,4 +304,68 @@ pub(super) fn capsule_entry_push<T: Lane>(
     let n = (contact - closest_point_on_segment(contact, a, b)).normalize_or(prev_fallback);
     let slid = slide(contact, p, n);
     (outside_capsule(slid, a, b, limit, n), hard)
+}
+
+/// The swept entry of a keep-out capsule (`a`–`b`) or sphere (`center`) of `limit` per
+/// lane, for the lanes of `need` ([`capsule_entry_push`], [`sphere_entry`]): the point
+/// each gives, and the capsule lanes left to the scalar narrow phase. Out of line: in
+/// AVX2 for the AVX lane type, else in the portable one (the same bits).
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+pub(super) fn entry<T: Lane>(
+    capsule: bool,
+    p: V3<T>,
+    prev: V3<T>,
+    center: V3<T>,
+    a: V3<T>,
+    b: V3<T>,
+    limit: T,
+    need: T::M,
+) -> (V3<T>, T::M) {
+    let args = (
+        p.f(),
+        prev.f(),
+        center.f(),
+        a.f(),
+        b.f(),
+        limit.f(),
+        need.m(),
+    );
+    #[cfg(target_arch = "x86_64")]
+    if T::AVX {
+        // SAFETY: a value of the AVX lane type exists only inside functions compiled with
+        // AVX2 after the CPU was found to have it (`crowd/avx.rs`), so the CPU has AVX2.
+        #[allow(unsafe_code)]
+        let (e, h) = unsafe { entry_avx2(capsule, args) };
+        return (V3::of(e), <T::M as Mask>::of(h));
+    }
+    let (e, h) = entry_portable(capsule, args);
+    (V3::of(e), <T::M as Mask>::of(h))
+}
+
+/// [`entry`]'s arguments in the portable lane type.
+type EntryArgs = (V3, V3, V3, V3, V3, F, M);
+
+#[inline(never)]
+fn entry_portable(capsule: bool, args: EntryArgs) -> (V3, M) {
+    entry_in::<F>(capsule, args)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[inline(never)]
+fn entry_avx2(capsule: bool, args: EntryArgs) -> (V3, M) {
+    entry_in::<Fa>(capsule, args)
+}
+
+#[inline(always)]
+fn entry_in<T: Lane>(capsule: bool, (p, prev, center, a, b, limit, need): EntryArgs) -> (V3, M) {
+    let (p, prev, limit) = (V3::<T>::of(p), V3::<T>::of(prev), T::of(limit));
+    if capsule {
+        let (a, b) = (V3::<T>::of(a), V3::<T>::of(b));
+        let (e, h) = capsule_entry_push(p, prev, a, b, limit);
+        (e.f(), h.and(<T::M as Mask>::of(need)).m())
+    } else {
+        (sphere_entry(p, prev, V3::of(center), limit).f(), M::NONE)
+    }
 }

@@ -227,6 +227,9 @@ pub trait Lane:
 {
     /// The per-lane condition of this type.
     type M: Mask;
+    /// Whether this is the AVX lane type (whose values exist only inside functions
+    /// compiled with AVX2, after the CPU was found to have it).
+    const AVX: bool = false;
     /// Every lane `v`.
     fn splat(v: f32) -> Self;
     /// From [`F`] (the same lanes).
