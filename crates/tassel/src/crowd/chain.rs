@@ -20,7 +20,7 @@ use crate::dynamics::chain::job::{
     chain_rng, gather_targets, gravity_cs, motion_cs, slerp_angle, wind_cs,
 };
 use crate::dynamics::chain::step::gravity_step;
-use crate::dynamics::chain::{ChainSettings, TimeMode};
+use crate::dynamics::chain::{ChainSettings, ClassicGravity, TimeMode};
 use crate::dynamics::path::CharacterPath;
 use crate::error::{Error, Result};
 use crate::math::Transform;
@@ -239,6 +239,8 @@ struct Scratch {
     one_normals: Vec<Vec3>,
     /// A point's broad phase: the lanes each member of its chain's collider list may touch.
     near: Vec<M>,
+    /// The last motion computed.
+    motion: MotionMemo,
 }
 
 impl Scratch {
@@ -274,6 +276,7 @@ impl Scratch {
                     .max()
                     .unwrap_or(0)
             ],
+            motion: MotionMemo::new(),
         }
     }
 }
@@ -710,12 +713,118 @@ struct Ctx<'c> {
 /// The per-lane inputs of a step that depend on where each character is: its motion since
 /// `from` (none when `from` is `None`), gravity's share and the wind, for the `active`
 /// lanes.
+#[derive(Debug, Clone, Copy)]
 struct Motion {
     move_cs: V3,
     rotate_cs: Q,
     gravity_step: V3,
     wind_cs: V3,
     wind_on: M,
+}
+
+/// The last [`motion`] computed, with everything it was computed from: the chains of a
+/// character mostly step with the same settings between the same transforms, so a lane
+/// group's other chains get it again without computing it.
+#[derive(Debug, Clone)]
+struct MotionMemo {
+    /// The settings' fields `motion` reads: gravity in world space, gravity, wind
+    /// direction and speed, classic gravity; `None` before the first.
+    settings: Option<(bool, Vec3, Vec3, f32, ClassicGravity)>,
+    dt: f32,
+    fixed: bool,
+    from: Option<Trs>,
+    to: Trs,
+    /// The lanes it was computed for.
+    active: M,
+    out: Motion,
+}
+
+impl MotionMemo {
+    fn new() -> MotionMemo {
+        MotionMemo {
+            settings: None,
+            dt: 0.0,
+            fixed: false,
+            from: None,
+            to: Trs::splat(&Transform::IDENTITY),
+            active: M::NONE,
+            out: Motion {
+                move_cs: V3::splat(Vec3::ZERO),
+                rotate_cs: Q::splat(Quat::IDENTITY),
+                gravity_step: V3::splat(Vec3::ZERO),
+                wind_cs: V3::splat(Vec3::ZERO),
+                wind_on: M::NONE,
+            },
+        }
+    }
+}
+
+/// The fields of `s` that [`motion`] reads.
+fn motion_settings(s: &ChainSettings) -> (bool, Vec3, Vec3, f32, ClassicGravity) {
+    (
+        s.gravity_in_world,
+        s.gravity,
+        s.wind.direction,
+        s.wind.speed,
+        s.classic_gravity,
+    )
+}
+
+/// Whether the lanes `m` of `a` and `b` hold the same bits.
+fn same_lanes(a: &Trs, b: &Trs, m: M) -> bool {
+    let fields = |t: &Trs| {
+        [
+            t.t.x, t.t.y, t.t.z, t.r.x, t.r.y, t.r.z, t.r.w, t.s.x, t.s.y, t.s.z,
+        ]
+    };
+    fields(a)
+        .iter()
+        .zip(fields(b).iter())
+        .all(|(x, y)| (0..LANES).all(|l| m.0[l] == 0 || x.0[l].to_bits() == y.0[l].to_bits()))
+}
+
+/// [`motion`], or the memo's when it was computed from the same (bit for bit) for every
+/// lane of `active`; the memo then holds this one.
+#[allow(clippy::too_many_arguments)]
+fn motion_memo(
+    memo: &mut MotionMemo,
+    s: &ChainSettings,
+    from: Option<&Trs>,
+    to: &Trs,
+    dt: f32,
+    fixed: bool,
+    active: M,
+    shared: bool,
+) -> Motion {
+    let settings = motion_settings(s);
+    let same_settings = memo.settings.is_some_and(|(g, gv, wd, ws, c)| {
+        let (g2, gv2, wd2, ws2, c2) = settings;
+        g == g2
+            && crate::math::same_bits(gv, gv2)
+            && crate::math::same_bits(wd, wd2)
+            && ws.to_bits() == ws2.to_bits()
+            && c == c2
+    });
+    let hit = same_settings
+        && memo.dt.to_bits() == dt.to_bits()
+        && memo.fixed == fixed
+        && active.and(memo.active.not()) == M::NONE
+        && match (from, &memo.from) {
+            (None, None) => true,
+            (Some(a), Some(b)) => same_lanes(a, b, active),
+            _ => false,
+        }
+        && same_lanes(to, &memo.to, active);
+    if !hit {
+        memo.out = motion(s, from, to, dt, fixed, active, shared);
+        memo.settings = Some(settings);
+        memo.dt = dt;
+        memo.fixed = fixed;
+        memo.from = from.copied();
+        memo.to = *to;
+        memo.active = active;
+    }
+    memo.out
 }
 
 fn motion(
@@ -1109,7 +1218,16 @@ impl Ctx<'_> {
         // Warm-up: settle in place with the current targets and no character motion.
         let fixed = set.mode == TimeMode::Fixed;
         if set.warmup_steps > 0 {
-            let mo = motion(set, None, &s.component, h, fixed, m, pack.shared);
+            let mo = motion_memo(
+                &mut s.motion,
+                set,
+                None,
+                &s.component,
+                h,
+                fixed,
+                m,
+                pack.shared,
+            );
             for _ in 0..set.warmup_steps {
                 let input = LaneStep {
                     targets: &s.targets,
@@ -1155,7 +1273,8 @@ impl Ctx<'_> {
         let set = &rig.chains[ci].settings;
         let dt = self.dt.min(set.max_delta_time);
         if dt > 0.0 {
-            let mo = motion(
+            let mo = motion_memo(
+                &mut s.motion,
                 set,
                 Some(&pack.prev_component),
                 &s.component,
@@ -1282,7 +1401,8 @@ impl Ctx<'_> {
                 }
             }
             let comp_b = Trs::select(active, &s.path_at, &Trs::splat(&Transform::IDENTITY));
-            let mo = motion(
+            let mo = motion_memo(
+                &mut s.motion,
                 set,
                 Some(&pack.last_step_component[ci]),
                 &comp_b,
@@ -1330,5 +1450,85 @@ impl Ctx<'_> {
             }
         }
         pack.accumulator[ci] = acc;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The memo answers as [`motion`] computed afresh, bit for bit, in the lanes asked,
+    /// over calls that repeat or change each of its inputs (settings, time, mode, either
+    /// transform in one lane, the lanes asked); and it is used (some calls hit).
+    #[test]
+    fn the_motion_memo_answers_as_motion() {
+        let mut rng = SplitMix64::new(3);
+        let mut u = |lo: f32, hi: f32| rng.range_f32(lo, hi);
+        let mut memo = MotionMemo::new();
+        let mut settings = ChainSettings::default();
+        let transform = |u: &mut dyn FnMut(f32, f32) -> f32| {
+            Transform::from_translation_rotation(
+                Vec3::new(u(-1.0, 1.0), u(-1.0, 1.0), u(-1.0, 1.0)),
+                Quat::from_euler(glam::EulerRot::XYZ, u(-3.0, 3.0), u(-3.0, 3.0), 0.0),
+            )
+        };
+        let mut from = Trs::splat(&transform(&mut u));
+        let mut to = Trs::splat(&transform(&mut u));
+        let (mut dt, mut fixed, mut has_from) = (1.0 / 60.0, true, true);
+        let mut active = M::ALL;
+        let mut hits = 0;
+        let bits = |m: &Motion, l: usize| {
+            let v = |v: Vec3| v.to_array().map(f32::to_bits);
+            (
+                v(m.move_cs.get(l)),
+                m.rotate_cs.get(l).to_array().map(f32::to_bits),
+                v(m.gravity_step.get(l)),
+                v(m.wind_cs.get(l)),
+                m.wind_on.0[l],
+            )
+        };
+        for round in 0..4000 {
+            let l = (u(0.0, 8.0) as usize).min(LANES - 1);
+            match round % 11 {
+                0 => from.set(l, &transform(&mut u)),
+                1 => to.set(l, &transform(&mut u)),
+                2 => settings.gravity = Vec3::new(0.0, u(-10.0, 0.0), 0.0),
+                3 => settings.gravity_in_world = !settings.gravity_in_world,
+                4 => settings.wind.direction = Vec3::new(u(-1.0, 1.0), 0.0, u(-1.0, 1.0)),
+                5 => dt = [1.0 / 60.0, 1.0 / 30.0][(round / 11) % 2],
+                6 => fixed = !fixed,
+                7 => has_from = !has_from,
+                8 => settings.wind.speed = [0.0, 0.5][(round / 11) % 2],
+                9 => {
+                    settings.classic_gravity = [
+                        ClassicGravity::DtSquared,
+                        ClassicGravity::PerFrame,
+                        ClassicGravity::HalfDtSquared,
+                    ][(round / 11) % 3]
+                }
+                _ => {
+                    active = M(std::array::from_fn(
+                        |_| if u(0.0, 1.0) < 0.8 { !0 } else { 0 },
+                    ))
+                }
+            }
+            // Often nothing changed since the last call (as for a character's next chain).
+            let calls = 1 + usize::from(u(0.0, 1.0) < 0.5);
+            for _ in 0..calls {
+                let f = has_from.then_some(&from);
+                let was = memo.out.move_cs.x.0.map(f32::to_bits);
+                let got = motion_memo(&mut memo, &settings, f, &to, dt, fixed, active, false);
+                let want = motion(&settings, f, &to, dt, fixed, active, false);
+                hits += usize::from(
+                    memo.settings.is_some() && was == got.move_cs.x.0.map(f32::to_bits),
+                );
+                for l in 0..LANES {
+                    if active.0[l] != 0 {
+                        assert_eq!(bits(&got, l), bits(&want, l), "round {round} lane {l}");
+                    }
+                }
+            }
+        }
+        assert!(hits > 1000, "{hits}");
     }
 }
