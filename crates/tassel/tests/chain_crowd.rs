@@ -340,3 +340,57 @@ fn chain_crowd_removes_and_adds_characters() {
         }
     }
 }
+
+/// A pose whose every joint is within the input limits but whose model pose overflows
+/// (scales of 1e6 compounding down a chain) names the first joint, in skeleton order,
+/// whose model transform is not finite, found here by the scalar model-pose job; the
+/// other lane groups step.
+#[test]
+fn chain_crowd_names_the_joint_whose_model_pose_overflows() {
+    use tassel::LocalToModelJob;
+    let (sk, settings) = builtin::bench_character(2, 9, 2);
+    let rig = Arc::new(ChainRig::new(&sk, &settings).unwrap());
+    let sk = Arc::new(sk);
+    let mut crowd = ChainCrowd::new(sk.clone(), rig).unwrap();
+    for _ in 0..12 {
+        crowd.add();
+    }
+    let rest = sk.rest().to_vec();
+    let mut huge = rest.clone();
+    for t in &mut huge {
+        t.scale = Vec3::splat(1.0e6);
+    }
+    assert!(huge.iter().all(|t| t.within_limits()));
+    let mut models = rest.clone();
+    LocalToModelJob {
+        skeleton: &sk,
+        root: Transform::IDENTITY,
+        locals: &huge,
+        models: &mut models,
+    }
+    .run()
+    .unwrap();
+    let first = models
+        .iter()
+        .position(|t| !t.is_finite())
+        .expect("the pose overflows");
+    let tip = crowd.rig().point_count() - 1;
+    let before = crowd.point(10, tip).unwrap();
+    let err = crowd
+        .frame(1.0 / 60.0, |i| CrowdPose {
+            transform: Transform::from_translation(Vec3::X * i as f32),
+            locals: if i == 3 { &huge } else { &rest },
+        })
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("crowd character 3") && err.contains(&format!("'{}'", sk.name(first))),
+        "{err} (expected joint {})",
+        sk.name(first)
+    );
+    assert_ne!(
+        crowd.point(10, tip).unwrap(),
+        before,
+        "the second lane group stepped"
+    );
+}

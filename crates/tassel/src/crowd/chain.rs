@@ -12,15 +12,15 @@
 #[cfg(target_arch = "x86_64")]
 use super::avx::Fa;
 use super::chain_step::{output_lanes, step_lanes, Bound, LaneShape, LaneStep};
-use super::lanes::{rotation_arc, Lane, Trs, F, LANES, M, Q, V3};
+use super::lanes::{rotation_arc, Lane, Mask, Trs, F, LANES, M, Q, V3};
 use super::CrowdPose;
 use crate::collide::PlacedCollider;
-use crate::dynamics::chain::compile::ChainRig;
+use crate::dynamics::chain::compile::{ChainRig, NONE, VIRTUAL};
 use crate::dynamics::chain::job::{
-    chain_rng, gather_targets, gravity_cs, motion_cs, slerp_angle, wind_cs,
+    chain_rng, gravity_cs, motion_cs, place_colliders, slerp_angle, wind_cs,
 };
 use crate::dynamics::chain::step::gravity_step;
-use crate::dynamics::chain::{ChainSettings, ClassicGravity, TimeMode};
+use crate::dynamics::chain::{ChainSettings, ClassicGravity, PlanarAxis, TimeMode};
 use crate::dynamics::path::CharacterPath;
 use crate::error::{Error, Result};
 use crate::math::Transform;
@@ -234,9 +234,6 @@ struct Scratch {
     path_at: Trs,
     /// The write-back's model rotations per joint (the rotator joints and their parents).
     rotations: Vec<Q>,
-    /// One character's targets and normals, for the scalar code.
-    one_targets: Vec<Vec3>,
-    one_normals: Vec<Vec3>,
     /// A point's broad phase: the lanes each member of its chain's collider list may touch.
     near: Vec<M>,
     /// The last motion computed.
@@ -266,8 +263,6 @@ impl Scratch {
             path_w: [f32::NAN; LANES],
             path_at: Trs::splat(&Transform::IDENTITY),
             rotations: vec![Q::splat(Quat::IDENTITY); joints],
-            one_targets: vec![Vec3::ZERO; n],
-            one_normals: vec![Vec3::Y; n],
             near: vec![
                 M::ALL;
                 rig.chains
@@ -921,10 +916,12 @@ fn check_pose(sk: &Skeleton, i: usize, pose: &CrowdPose) -> Result<()> {
 /// [`crate::pose::local_to_model_into`] for [`LANES`] characters at once. [`Trs::mul`] is
 /// [`Transform::mul_transform`] operation for operation, so each lane gets the bits the
 /// scalar job gives (the identity above the roots, as there).
+/// Returns the lanes with a non-finite model transform.
 #[inline(always)]
-fn model_pose_lanes<T: Lane>(sk: &Skeleton, s: &mut Scratch, count: usize) {
+fn model_pose_lanes<T: Lane>(sk: &Skeleton, s: &mut Scratch, count: usize) -> M {
     let n = sk.len();
     let root = Trs::<F>::splat(&Transform::IDENTITY);
+    let mut bad = <T::M as Mask>::NONE;
     for j in 0..n {
         let mut local = root;
         for l in 0..count {
@@ -935,11 +932,54 @@ fn model_pose_lanes<T: Lane>(sk: &Skeleton, s: &mut Scratch, count: usize) {
         let model = match sk.parent(j) {
             Some(p) => Trs::<T>::of(&s.lane_models[p]).mul(&local),
             None => Trs::<T>::splat(&Transform::IDENTITY).mul(&local),
-        }
-        .f();
+        };
+        bad = bad.or(model
+            .t
+            .finite()
+            .and(model.r.finite())
+            .and(model.s.finite())
+            .not());
+        let model = model.f();
         s.lane_models[j] = model;
         for l in 0..count {
             s.models[l * n + j] = model.get(l);
+        }
+    }
+    bad.m()
+}
+
+/// `gather_targets`' animated targets and planar normals per point, for every lane at
+/// once from the lane pose, by its operations (each lane gets the scalar function's bits).
+#[inline(always)]
+fn targets_lanes<T: Lane>(sk: &Skeleton, rig: &ChainRig, s: &mut Scratch) {
+    let models = &s.lane_models;
+    let y = V3::<T>::splat(Vec3::Y);
+    for p in 0..rig.joint.len() {
+        let j = rig.joint[p];
+        let parent = rig.parent[p];
+        s.targets[p] = if j == VIRTUAL {
+            let leaf = rig.joint[parent as usize] as usize;
+            let m = Trs::<T>::of(&models[leaf]);
+            let up = m.r.mul_vec3(y);
+            let dir = match sk.parent(leaf) {
+                Some(q) => (m.t - V3::<T>::of(models[q].t)).normalize_or(up),
+                None => up,
+            };
+            (m.t + dir * T::splat(rig.dummy_length[p])).f()
+        } else {
+            models[j as usize].t
+        };
+        if parent != NONE {
+            let pj = rig.joint[parent as usize] as usize;
+            let axis = rig.chains[rig.chain_of[p] as usize]
+                .settings
+                .planar_constraint;
+            let local_axis = match axis {
+                PlanarAxis::X => Vec3::X,
+                PlanarAxis::Z => Vec3::Z,
+                _ => Vec3::Y,
+            };
+            s.normals[p] = Q::<T>::of(models[pj].r).mul_vec3(V3::splat(local_axis)).f();
         }
     }
 }
@@ -961,9 +1001,9 @@ impl Ctx<'_> {
         let n = sk.len();
         let m = rig.colliders.len();
         // First each lane's input, checked and copied, up to the first bad one; then the
-        // model pose of those lanes at once; then per lane, in order, the model pose's
-        // check (so the error named is the one the lane-by-lane order meets first) and the
-        // targets and colliders.
+        // model pose, targets and normals of those lanes at once; then per lane, in
+        // order, the model pose's check (so the error named is the one the lane-by-lane
+        // order meets first) and the colliders.
         let mut first_bad = None;
         for lane in 0..pack.count {
             let i = base + lane;
@@ -976,11 +1016,12 @@ impl Ctx<'_> {
             scratch.locals[lane * n..(lane + 1) * n].copy_from_slice(pose.locals);
         }
         let good = first_bad.as_ref().map_or(pack.count, |(lane, _)| *lane);
-        self.model_pose(scratch, good);
+        let not_finite = self.model_pose(scratch, good);
         for lane in 0..good {
             let i = base + lane;
-            let models = &mut scratch.models[lane * n..(lane + 1) * n];
-            if let Some(j) = models.iter().position(|t| !t.is_finite()) {
+            let models = &scratch.models[lane * n..(lane + 1) * n];
+            let first_not_finite = || models.iter().position(|t| !t.is_finite());
+            if let Some(j) = not_finite.get(lane).then(first_not_finite).flatten() {
                 return Err((
                     lane,
                     Error::NonFinite(format!(
@@ -990,20 +1031,7 @@ impl Ctx<'_> {
                 ));
             }
             let colliders = &mut scratch.colliders[lane * m..(lane + 1) * m];
-            gather_targets(
-                sk,
-                rig,
-                models,
-                &mut scratch.one_targets,
-                &mut scratch.one_normals,
-                colliders,
-            );
-            for (d, v) in scratch.targets.iter_mut().zip(&scratch.one_targets) {
-                d.set(lane, *v);
-            }
-            for (d, v) in scratch.normals.iter_mut().zip(&scratch.one_normals) {
-                d.set(lane, *v);
-            }
+            place_colliders(rig, models, colliders);
             for (b, c) in scratch.bounds.iter_mut().zip(colliders.iter()) {
                 b.set(lane, c);
             }
@@ -1014,8 +1042,9 @@ impl Ctx<'_> {
         }
     }
 
-    /// [`model_pose_lanes`] with AVX2 where the CPU has it (as [`Ctx::step`]).
-    fn model_pose(&self, s: &mut Scratch, count: usize) {
+    /// [`model_pose_lanes`] and [`targets_lanes`] with AVX2 where the CPU has it (as
+    /// [`Ctx::step`]): the lanes with a non-finite model transform.
+    fn model_pose(&self, s: &mut Scratch, count: usize) -> M {
         #[cfg(target_arch = "x86_64")]
         if self.avx2 && std::arch::is_x86_feature_detected!("avx2") {
             // SAFETY: `model_pose_avx2` only requires the AVX2 instructions, and the CPU
@@ -1025,14 +1054,18 @@ impl Ctx<'_> {
                 return self.model_pose_avx2(s, count);
             }
         }
-        model_pose_lanes::<F>(self.sk, s, count)
+        let bad = model_pose_lanes::<F>(self.sk, s, count);
+        targets_lanes::<F>(self.sk, self.rig, s);
+        bad
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    fn model_pose_avx2(&self, s: &mut Scratch, count: usize) {
+    fn model_pose_avx2(&self, s: &mut Scratch, count: usize) -> M {
         // The explicit AVX lane type, only here after the CPU was found to have AVX2.
-        model_pose_lanes::<Fa>(self.sk, s, count)
+        let bad = model_pose_lanes::<Fa>(self.sk, s, count);
+        targets_lanes::<Fa>(self.sk, self.rig, s);
+        bad
     }
 
     /// One frame of one lane group whose input is in `s`: with AVX2 where the CPU has it

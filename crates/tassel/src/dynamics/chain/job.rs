@@ -394,6 +394,15 @@ pub(crate) fn gather_targets(
             normals[p] = models[pj].rotation * local_axis;
         }
     }
+    place_colliders(rig, models, colliders);
+}
+
+/// The rig's colliders placed on the model pose `models`.
+pub(crate) fn place_colliders(
+    rig: &ChainRig,
+    models: &[Transform],
+    colliders: &mut [PlacedCollider],
+) {
     for (placed, c) in colliders.iter_mut().zip(&rig.colliders) {
         *placed = c.place(models, None);
     }
