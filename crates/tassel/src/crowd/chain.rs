@@ -206,8 +206,7 @@ impl Pack {
 /// One thread's working buffers: a frame's input and a step's interpolated input.
 #[derive(Debug, Clone)]
 struct Scratch {
-    /// Per lane (`n` joints each): the animated locals and models.
-    locals: Vec<Transform>,
+    /// Per lane (`n` joints each): the animated models.
     models: Vec<Transform>,
     /// The model pose per joint, all lanes side by side (computed in lanes, then copied
     /// into `models`).
@@ -246,7 +245,6 @@ impl Scratch {
         let m = rig.colliders.len();
         let zero = V3::splat(Vec3::ZERO);
         Scratch {
-            locals: vec![Transform::IDENTITY; joints * LANES],
             models: vec![Transform::IDENTITY; joints * LANES],
             lane_models: vec![Trs::splat(&Transform::IDENTITY); joints],
             lane_local_rotations: vec![Q::splat(Quat::IDENTITY); joints],
@@ -912,20 +910,25 @@ fn check_pose(sk: &Skeleton, i: usize, pose: &CrowdPose) -> Result<()> {
     Ok(())
 }
 
-/// The model pose of the first `count` lanes from their locals in `s`, into `s.models`:
+/// The model pose of the first `count` lanes from their animated `locals`, into `s.models`:
 /// [`crate::pose::local_to_model_into`] for [`LANES`] characters at once. [`Trs::mul`] is
 /// [`Transform::mul_transform`] operation for operation, so each lane gets the bits the
 /// scalar job gives (the identity above the roots, as there).
 /// Returns the lanes with a non-finite model transform.
 #[inline(always)]
-fn model_pose_lanes<T: Lane>(sk: &Skeleton, s: &mut Scratch, count: usize) -> M {
+fn model_pose_lanes<T: Lane>(
+    sk: &Skeleton,
+    locals: &[&[Transform]; LANES],
+    s: &mut Scratch,
+    count: usize,
+) -> M {
     let n = sk.len();
     let root = Trs::<F>::splat(&Transform::IDENTITY);
     let mut bad = <T::M as Mask>::NONE;
     for j in 0..n {
         let mut local = root;
         for l in 0..count {
-            local.set(l, &s.locals[l * n + j]);
+            local.set(l, &locals[l][j]);
         }
         s.lane_local_rotations[j] = local.r;
         let local = Trs::<T>::of(&local);
@@ -1005,6 +1008,7 @@ impl Ctx<'_> {
         // order, the model pose's check (so the error named is the one the lane-by-lane
         // order meets first) and the colliders.
         let mut first_bad = None;
+        let mut locals: [&[Transform]; LANES] = [&[]; LANES];
         for lane in 0..pack.count {
             let i = base + lane;
             let pose = input(i);
@@ -1013,10 +1017,10 @@ impl Ctx<'_> {
                 break;
             }
             scratch.component.set(lane, &pose.transform);
-            scratch.locals[lane * n..(lane + 1) * n].copy_from_slice(pose.locals);
+            locals[lane] = pose.locals;
         }
         let good = first_bad.as_ref().map_or(pack.count, |(lane, _)| *lane);
-        let not_finite = self.model_pose(scratch, good);
+        let not_finite = self.model_pose(&locals, scratch, good);
         for lane in 0..good {
             let i = base + lane;
             let models = &scratch.models[lane * n..(lane + 1) * n];
@@ -1044,26 +1048,26 @@ impl Ctx<'_> {
 
     /// [`model_pose_lanes`] and [`targets_lanes`] with AVX2 where the CPU has it (as
     /// [`Ctx::step`]): the lanes with a non-finite model transform.
-    fn model_pose(&self, s: &mut Scratch, count: usize) -> M {
+    fn model_pose(&self, locals: &[&[Transform]; LANES], s: &mut Scratch, count: usize) -> M {
         #[cfg(target_arch = "x86_64")]
         if self.avx2 && std::arch::is_x86_feature_detected!("avx2") {
             // SAFETY: `model_pose_avx2` only requires the AVX2 instructions, and the CPU
             // was just checked to have them.
             #[allow(unsafe_code)]
             unsafe {
-                return self.model_pose_avx2(s, count);
+                return self.model_pose_avx2(locals, s, count);
             }
         }
-        let bad = model_pose_lanes::<F>(self.sk, s, count);
+        let bad = model_pose_lanes::<F>(self.sk, locals, s, count);
         targets_lanes::<F>(self.sk, self.rig, s);
         bad
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    fn model_pose_avx2(&self, s: &mut Scratch, count: usize) -> M {
+    fn model_pose_avx2(&self, locals: &[&[Transform]; LANES], s: &mut Scratch, count: usize) -> M {
         // The explicit AVX lane type, only here after the CPU was found to have AVX2.
-        let bad = model_pose_lanes::<Fa>(self.sk, s, count);
+        let bad = model_pose_lanes::<Fa>(self.sk, locals, s, count);
         targets_lanes::<Fa>(self.sk, self.rig, s);
         bad
     }
