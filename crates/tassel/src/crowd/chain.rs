@@ -20,7 +20,7 @@ use crate::dynamics::chain::job::{
     chain_rng, gravity_cs, motion_cs, place_colliders, slerp_angle, wind_cs,
 };
 use crate::dynamics::chain::step::gravity_step;
-use crate::dynamics::chain::{ChainSettings, ClassicGravity, PlanarAxis, TimeMode};
+use crate::dynamics::chain::{ChainSettings, ClassicGravity, TimeMode};
 use crate::dynamics::path::CharacterPath;
 use crate::error::{Error, Result};
 use crate::math::Transform;
@@ -974,15 +974,8 @@ fn targets_lanes<T: Lane>(sk: &Skeleton, rig: &ChainRig, s: &mut Scratch) {
         };
         if parent != NONE {
             let pj = rig.joint[parent as usize] as usize;
-            let axis = rig.chains[rig.chain_of[p] as usize]
-                .settings
-                .planar_constraint;
-            let local_axis = match axis {
-                PlanarAxis::X => Vec3::X,
-                PlanarAxis::Z => Vec3::Z,
-                _ => Vec3::Y,
-            };
-            s.normals[p] = Q::<T>::of(models[pj].r).mul_vec3(V3::splat(local_axis)).f();
+            let axis = V3::splat(rig.planar_local_axis(p));
+            s.normals[p] = Q::<T>::of(models[pj].r).mul_vec3(axis).f();
         }
     }
 }

@@ -4,9 +4,10 @@
 //! operation ([`super::lanes`] repeats glam's IEEE operations lane by lane), with every
 //! branch that depends on a character's state taken per lane (a mask). The cone limit,
 //! the broad phase, the colliders' quick rejection and, for keep-out spheres and
-//! capsules, the narrow phase's contact decision and its push of a point found inside run
-//! in lanes; a step that entered one of those (the swept contact) and every other shape
-//! are left to the scalar colliders, asked only for the lanes that need them.
+//! capsules, the narrow phase's contact decision, its push of a point found inside and
+//! the swept entry of a step that entered one ([`super::entry_lanes`]) run in lanes; a
+//! capsule graze whose closed-form entry finds no root and every other shape are left to
+//! the scalar colliders, asked only for the lanes that need them.
 
 use super::entry_lanes::entry;
 use super::lanes::{
@@ -322,9 +323,9 @@ fn collide<T: Lane>(
                 continue;
             }
         }
-        // Keep-out spheres and capsules: the lanes asked that the step did not enter get
-        // their point from the lanes' own narrow phase; the rest (entries, other shapes)
-        // from the scalar one.
+        // Keep-out spheres and capsules: the lanes asked get their point from the lanes'
+        // own narrow phase (a push, or the swept entry); other shapes, and a capsule
+        // graze the lanes cannot answer, from the scalar one.
         let (a, b) = (V3::of(bound.a), V3::of(bound.b));
         let contact = match shape.decision {
             Decision::Sphere(radius) => {

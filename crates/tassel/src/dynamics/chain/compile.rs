@@ -60,6 +60,20 @@ pub struct ChainRig {
 }
 
 impl ChainRig {
+    /// The axis, in the parent joint's space, that point `p`'s planar constraint keeps
+    /// its bone perpendicular to (its chain's `planar_constraint`; Y when it has none).
+    pub(crate) fn planar_local_axis(&self, p: usize) -> glam::Vec3 {
+        use super::settings::PlanarAxis;
+        match self.chains[self.chain_of[p] as usize]
+            .settings
+            .planar_constraint
+        {
+            PlanarAxis::X => glam::Vec3::X,
+            PlanarAxis::Z => glam::Vec3::Z,
+            _ => glam::Vec3::Y,
+        }
+    }
+
     /// Compiles `rig` for `skeleton`: resolves bone names, collects each chain's points
     /// depth-first, evaluates the parameter curves. Errors name the chain or collider.
     pub fn new(skeleton: &Skeleton, rig: &RigSettings) -> Result<Self> {

@@ -1,7 +1,7 @@
 //! Per-character chain state and the frame job.
 
 use super::compile::{ChainRig, NONE, VIRTUAL};
-use super::settings::{PlanarAxis, TimeMode};
+use super::settings::TimeMode;
 use super::step::{step_chain, StepInput};
 use crate::collide::{NearSet, PlacedCollider};
 use crate::controller::Level;
@@ -383,15 +383,7 @@ pub(crate) fn gather_targets(
         };
         if parent != NONE {
             let pj = rig.joint[parent as usize] as usize;
-            let axis = rig.chains[rig.chain_of[p] as usize]
-                .settings
-                .planar_constraint;
-            let local_axis = match axis {
-                PlanarAxis::X => Vec3::X,
-                PlanarAxis::Z => Vec3::Z,
-                _ => Vec3::Y,
-            };
-            normals[p] = models[pj].rotation * local_axis;
+            normals[p] = models[pj].rotation * rig.planar_local_axis(p);
         }
     }
     place_colliders(rig, models, colliders);
