@@ -206,10 +206,10 @@ impl Pack {
 /// One thread's working buffers: a frame's input and a step's interpolated input.
 #[derive(Debug, Clone)]
 struct Scratch {
-    /// Per lane (`n` joints each): the animated models.
+    /// Per lane (`n` joints each): the animated models of the colliders' bones (the
+    /// other joints' are not kept).
     models: Vec<Transform>,
-    /// The model pose per joint, all lanes side by side (computed in lanes, then copied
-    /// into `models`).
+    /// The model pose per joint, all lanes side by side (computed in lanes).
     lane_models: Vec<Trs>,
     /// The animated local rotation per joint, all lanes side by side.
     lane_local_rotations: Vec<Q>,
@@ -919,7 +919,8 @@ fn check_pose(sk: &Skeleton, i: usize, pose: &CrowdPose) -> Result<()> {
     Ok(())
 }
 
-/// The model pose of the first `count` lanes from their animated `locals`, into `s.models`:
+/// The model pose of the first `count` lanes from their animated `locals`, into
+/// `s.lane_models`:
 /// [`crate::pose::local_to_model_into`] for [`LANES`] characters at once. [`Trs::mul`] is
 /// [`Transform::mul_transform`] operation for operation, so each lane gets the bits the
 /// scalar job gives (the identity above the roots, as there).
@@ -951,11 +952,7 @@ fn model_pose_lanes<T: Lane>(
             .and(model.r.finite())
             .and(model.s.finite())
             .not());
-        let model = model.f();
-        s.lane_models[j] = model;
-        for l in 0..count {
-            s.models[l * n + j] = model.get(l);
-        }
+        s.lane_models[j] = model.f();
     }
     bad.m()
 }
@@ -1025,8 +1022,8 @@ impl Ctx<'_> {
         let not_finite = self.model_pose(&locals, scratch, good);
         for lane in 0..good {
             let i = base + lane;
-            let models = &scratch.models[lane * n..(lane + 1) * n];
-            let first_not_finite = || models.iter().position(|t| !t.is_finite());
+            let lane_models = &scratch.lane_models;
+            let first_not_finite = || (0..n).position(|j| !lane_models[j].get(lane).is_finite());
             if let Some(j) = not_finite.get(lane).then(first_not_finite).flatten() {
                 return Err((
                     lane,
@@ -1035,6 +1032,11 @@ impl Ctx<'_> {
                         sk.name(j)
                     )),
                 ));
+            }
+            // The colliders' bones' models out of the lanes (no other joint is read).
+            let models = &mut scratch.models[lane * n..(lane + 1) * n];
+            for c in &rig.colliders {
+                models[c.bone] = scratch.lane_models[c.bone].get(lane);
             }
             let colliders = &mut scratch.colliders[lane * m..(lane + 1) * m];
             place_colliders(rig, models, colliders);
