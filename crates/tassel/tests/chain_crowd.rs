@@ -394,3 +394,90 @@ fn chain_crowd_names_the_joint_whose_model_pose_overflows() {
         "the second lane group stepped"
     );
 }
+
+/// The crowd accepts and rejects an animated pose exactly where the single-character
+/// path does (`CharacterSim::frame`, `Transform::within_limits`): rotations whose squared
+/// norm lies just inside and just outside the accepted band, coordinates and scales at
+/// the limit and one step of `f32` beyond it, NaN and infinity; a rejected pose names
+/// the same joint. Two bad characters in one lane group: the first one is named, whatever
+/// is wrong with either.
+#[test]
+fn chain_crowd_checks_the_input_limits_as_the_single_path() {
+    let (sk, settings) = builtin::bench_character(3, 4, 2);
+    let rig = Arc::new(ChainRig::new(&sk, &settings).unwrap());
+    let arc = Arc::new(sk.clone());
+    let mut crowd = ChainCrowd::new(arc, rig).unwrap();
+    for _ in 0..12 {
+        crowd.add();
+    }
+    let rest = sk.rest().to_vec();
+    let max = tassel::limits::MAX_COORDINATE;
+    let beyond = f32::from_bits(max.to_bits() + 1);
+    let j = 5;
+    let mut variants: Vec<Transform> = Vec::new();
+    for norm2 in [0.79f32, 1.21] {
+        for d in [-2e-4f32, -1e-6, 1e-6, 2e-4] {
+            let mut t = rest[j];
+            let unit = glam::Quat::from_axis_angle(Vec3::new(1.0, 2.0, 3.0).normalize(), 0.3);
+            t.rotation = glam::Quat::from_array(unit.to_array().map(|c| c * (norm2 + d).sqrt()));
+            variants.push(t);
+        }
+    }
+    for v in [max, -max, beyond, -beyond, f32::INFINITY, f32::NAN] {
+        let mut t = rest[j];
+        t.translation.y = v;
+        variants.push(t);
+        let mut t = rest[j];
+        t.scale.z = v;
+        variants.push(t);
+    }
+    let mut t = rest[j];
+    t.rotation.w = f32::NAN;
+    variants.push(t);
+    let (mut accepted, mut rejected) = (0, 0);
+    for (k, v) in variants.iter().enumerate() {
+        let mut pose = rest.clone();
+        pose[j] = *v;
+        let mut sim = CharacterSim::new(sk.clone(), &settings).unwrap();
+        let single = sim.frame(&pose, Transform::IDENTITY, 1.0 / 60.0);
+        let crowd_says = crowd.frame(1.0 / 60.0, |i| CrowdPose {
+            transform: Transform::IDENTITY,
+            locals: if i == 5 { &pose } else { &rest },
+        });
+        match (single, crowd_says) {
+            (Ok(_), Ok(())) => accepted += 1,
+            (Err(_), Err(e)) => {
+                let e = e.to_string();
+                assert!(
+                    e.contains("crowd character 5") && e.contains(&format!("'{}'", sk.name(j))),
+                    "variant {k} ({v:?}): {e}"
+                );
+                rejected += 1;
+            }
+            (single, crowd) => panic!("variant {k} ({v:?}): single {single:?}, crowd {crowd:?}"),
+        }
+    }
+    // Counted by hand: inside the band (2 of 4 near each end) and at ± the limit (2 × 2)
+    // accepted; outside the band, one step beyond the limit, infinity and NaN rejected.
+    assert_eq!((accepted, rejected), (8, 13));
+    // Two bad characters in lane group 0: a bad local at 2 and a bad transform at 6, and
+    // the other way round; the first is named.
+    let mut bad = rest.clone();
+    bad[j].translation.x = f32::NAN;
+    let far = Transform::from_translation(Vec3::splat(f32::INFINITY));
+    for (local_at, transform_at) in [(2, 6), (6, 2)] {
+        let e = crowd
+            .frame(1.0 / 60.0, |i| CrowdPose {
+                transform: if i == transform_at {
+                    far
+                } else {
+                    Transform::IDENTITY
+                },
+                locals: if i == local_at { &bad } else { &rest },
+            })
+            .unwrap_err()
+            .to_string();
+        let first = local_at.min(transform_at);
+        assert!(e.contains(&format!("crowd character {first}:")), "{e}");
+    }
+}

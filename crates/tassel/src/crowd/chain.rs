@@ -902,17 +902,23 @@ fn check_pose(sk: &Skeleton, i: usize, pose: &CrowdPose) -> Result<()> {
             got: pose.locals.len(),
         });
     }
-    if let Some(j) = pose.locals.iter().position(|t| !t.within_limits()) {
+    check_locals(sk, i, pose.locals)?;
+    if !pose.transform.within_limits() {
+        return Err(Error::NonFinite(format!(
+            "crowd character {i}: transform is not finite or lies beyond {:e}",
+            crate::limits::MAX_COORDINATE
+        )));
+    }
+    Ok(())
+}
+
+/// [`check_pose`]'s check of the animated locals (of the skeleton's length).
+fn check_locals(sk: &Skeleton, i: usize, locals: &[Transform]) -> Result<()> {
+    if let Some(j) = locals.iter().position(|t| !t.within_limits()) {
         return Err(Error::NonFinite(format!(
             "crowd character {i}: animated pose of joint '{}' is not finite, not a unit \
              rotation, or lies beyond {:e}",
             sk.name(j),
-            crate::limits::MAX_COORDINATE
-        )));
-    }
-    if !pose.transform.within_limits() {
-        return Err(Error::NonFinite(format!(
-            "crowd character {i}: transform is not finite or lies beyond {:e}",
             crate::limits::MAX_COORDINATE
         )));
     }
@@ -924,17 +930,23 @@ fn check_pose(sk: &Skeleton, i: usize, pose: &CrowdPose) -> Result<()> {
 /// [`crate::pose::local_to_model_into`] for [`LANES`] characters at once. [`Trs::mul`] is
 /// [`Transform::mul_transform`] operation for operation, so each lane gets the bits the
 /// scalar job gives (the identity above the roots, as there).
-/// Returns the lanes with a non-finite model transform.
+/// Returns the lanes with a non-finite model transform, and the lanes whose locals may
+/// not all lie within the input limits ([`Transform::within_limits`]: every coordinate
+/// checked exactly, the rotation's squared norm with a margin far above its rounding;
+/// [`check_locals`] decides for these).
 #[inline(always)]
 fn model_pose_lanes<T: Lane>(
     sk: &Skeleton,
     locals: &[&[Transform]; LANES],
     s: &mut Scratch,
     count: usize,
-) -> M {
+) -> (M, M) {
     let n = sk.len();
     let root = Trs::<F>::splat(&Transform::IDENTITY);
     let mut bad = <T::M as Mask>::NONE;
+    let mut sure = <T::M as Mask>::ALL;
+    let max = T::splat(crate::limits::MAX_COORDINATE);
+    let within = |v: V3<T>| v.x.le(max).and(v.y.le(max)).and(v.z.le(max));
     for j in 0..n {
         let mut local = root;
         for l in 0..count {
@@ -942,6 +954,11 @@ fn model_pose_lanes<T: Lane>(
         }
         s.lane_local_rotations[j] = local.r;
         let local = Trs::<T>::of(&local);
+        let (t, sc) = (local.t.abs(), local.s.abs());
+        let unit = (local.r.dot(local.r) - T::splat(1.0))
+            .abs()
+            .le(T::splat(0.2));
+        sure = sure.and(unit).and(within(t)).and(within(sc));
         let model = match sk.parent(j) {
             Some(p) => Trs::<T>::of(&s.lane_models[p]).mul(&local),
             None => Trs::<T>::splat(&Transform::IDENTITY).mul(&local),
@@ -954,7 +971,7 @@ fn model_pose_lanes<T: Lane>(
             .not());
         s.lane_models[j] = model.f();
     }
-    bad.m()
+    (bad.m(), sure.not().m())
 }
 
 /// `gather_targets`' animated targets and planar normals per point, for every lane at
@@ -1006,22 +1023,30 @@ impl Ctx<'_> {
         // model pose, targets and normals of those lanes at once; then per lane, in
         // order, the model pose's check (so the error named is the one the lane-by-lane
         // order meets first) and the colliders.
+        // (The locals' limits are checked in lanes with the model pose, and lane by lane
+        // only where the lanes are unsure; a lane's errors still come in `check_pose`'s
+        // order, and the first lane's with one is the one reported.)
         let mut first_bad = None;
         let mut locals: [&[Transform]; LANES] = [&[]; LANES];
         for lane in 0..pack.count {
             let i = base + lane;
             let pose = input(i);
-            if let Err(e) = check_pose(sk, i, &pose) {
-                first_bad = Some((lane, e));
-                break;
+            if pose.locals.len() != n || !pose.transform.within_limits() {
+                if let Err(e) = check_pose(sk, i, &pose) {
+                    first_bad = Some((lane, e));
+                    break;
+                }
             }
             scratch.component.set(lane, &pose.transform);
             locals[lane] = pose.locals;
         }
         let good = first_bad.as_ref().map_or(pack.count, |(lane, _)| *lane);
-        let not_finite = self.model_pose(&locals, scratch, good);
+        let (not_finite, unsure) = self.model_pose(&locals, scratch, good);
         for lane in 0..good {
             let i = base + lane;
+            if unsure.get(lane) {
+                check_locals(sk, i, locals[lane]).map_err(|e| (lane, e))?;
+            }
             let lane_models = &scratch.lane_models;
             let first_not_finite = || (0..n).position(|j| !lane_models[j].get(lane).is_finite());
             if let Some(j) = not_finite.get(lane).then(first_not_finite).flatten() {
@@ -1052,7 +1077,7 @@ impl Ctx<'_> {
 
     /// [`model_pose_lanes`] and [`targets_lanes`] with AVX2 where the CPU has it (as
     /// [`Ctx::step`]): the lanes with a non-finite model transform.
-    fn model_pose(&self, locals: &[&[Transform]; LANES], s: &mut Scratch, count: usize) -> M {
+    fn model_pose(&self, locals: &[&[Transform]; LANES], s: &mut Scratch, count: usize) -> (M, M) {
         #[cfg(target_arch = "x86_64")]
         if self.avx2 && std::arch::is_x86_feature_detected!("avx2") {
             // SAFETY: `model_pose_avx2` only requires the AVX2 instructions, and the CPU
@@ -1069,7 +1094,12 @@ impl Ctx<'_> {
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    fn model_pose_avx2(&self, locals: &[&[Transform]; LANES], s: &mut Scratch, count: usize) -> M {
+    fn model_pose_avx2(
+        &self,
+        locals: &[&[Transform]; LANES],
+        s: &mut Scratch,
+        count: usize,
+    ) -> (M, M) {
         // The explicit AVX lane type, only here after the CPU was found to have AVX2.
         let bad = model_pose_lanes::<Fa>(self.sk, locals, s, count);
         targets_lanes::<Fa>(self.sk, self.rig, s);
