@@ -769,16 +769,25 @@ fn motion_settings(s: &ChainSettings) -> (bool, Vec3, Vec3, f32, ClassicGravity)
 }
 
 /// Whether the lanes `m` of `a` and `b` hold the same bits.
+#[inline]
 fn same_lanes(a: &Trs, b: &Trs, m: M) -> bool {
-    let fields = |t: &Trs| {
-        [
-            t.t.x, t.t.y, t.t.z, t.r.x, t.r.y, t.r.z, t.r.w, t.s.x, t.s.y, t.s.z,
-        ]
+    // The differing bits of every field in the lanes of `m`, ORed together (no branch).
+    let differ = |x: &F, y: &F| {
+        (0..LANES).fold(0, |d, l| {
+            d | ((x.0[l].to_bits() ^ y.0[l].to_bits()) & m.0[l])
+        })
     };
-    fields(a)
-        .iter()
-        .zip(fields(b).iter())
-        .all(|(x, y)| (0..LANES).all(|l| m.0[l] == 0 || x.0[l].to_bits() == y.0[l].to_bits()))
+    let d = differ(&a.t.x, &b.t.x)
+        | differ(&a.t.y, &b.t.y)
+        | differ(&a.t.z, &b.t.z)
+        | differ(&a.r.x, &b.r.x)
+        | differ(&a.r.y, &b.r.y)
+        | differ(&a.r.z, &b.r.z)
+        | differ(&a.r.w, &b.r.w)
+        | differ(&a.s.x, &b.s.x)
+        | differ(&a.s.y, &b.s.y)
+        | differ(&a.s.z, &b.s.z);
+    d == 0
 }
 
 /// [`motion`], or the memo's when it was computed from the same (bit for bit) for every
