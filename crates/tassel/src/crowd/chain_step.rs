@@ -108,12 +108,47 @@ impl LaneShape {
 /// narrow phase's own operations: which lanes it may move (the others get their point
 /// back unchanged), which of those the step *entered* (the swept contact, left to the
 /// scalar narrow phase: rarer, and with a root finding of its own), and for the lanes it
-/// may move without an entry, the point it gives back (pushed out to the surface).
+/// may move without an entry, the point it gives back (pushed out to the surface); and
+/// what the swept entry computes again ([`super::entry_lanes`] takes it from here).
 #[derive(Clone, Copy)]
 pub(super) struct LaneContact<T: Lane> {
     pub may: T::M,
     pub entered: T::M,
     pub pushed: V3<T>,
+    /// The push's fallback direction, from the step's start.
+    pub fallback: V3<T>,
+    /// A capsule's: the share of the step at its closest approach to the axis, and the
+    /// step's start's distance from the axis (a sphere's: 0).
+    pub along: T,
+    pub prev_dist: T,
+}
+
+impl<T: Lane> LaneContact<T> {
+    /// In the portable lane type (the same lanes).
+    #[inline(always)]
+    pub(super) fn f(&self) -> LaneContact<F> {
+        LaneContact {
+            may: self.may.m(),
+            entered: self.entered.m(),
+            pushed: self.pushed.f(),
+            fallback: self.fallback.f(),
+            along: self.along.f(),
+            prev_dist: self.prev_dist.f(),
+        }
+    }
+
+    /// From the portable lane type (the same lanes).
+    #[inline(always)]
+    pub(super) fn of(c: &LaneContact<F>) -> LaneContact<T> {
+        LaneContact {
+            may: <T::M as Mask>::of(c.may),
+            entered: <T::M as Mask>::of(c.entered),
+            pushed: V3::of(c.pushed),
+            fallback: V3::of(c.fallback),
+            along: T::of(c.along),
+            prev_dist: T::of(c.prev_dist),
+        }
+    }
 }
 
 /// [`crate::collide::push_out_of_sphere`] per lane, as far as it goes without an entry:
@@ -140,6 +175,9 @@ pub(super) fn sphere_contact<T: Lane>(
         may: entered.or(d.dot(d).lt(limit * limit)),
         entered,
         pushed: center + d.normalize_or(fallback) * limit,
+        fallback,
+        along: T::splat(0.0),
+        prev_dist: T::splat(0.0),
     }
 }
 
@@ -179,6 +217,9 @@ pub(super) fn capsule_contact<T: Lane>(
         may: entered.or(d.dot(d).lt(limit * limit)),
         entered,
         pushed: c + d.normalize_or(fallback) * limit,
+        fallback,
+        along: s,
+        prev_dist,
     }
 }
 
@@ -351,7 +392,7 @@ fn collide<T: Lane>(
             }
             // The entries: in lanes too, but for a capsule's graze whose closed form
             // found no root (the scalar narrow phase bisects there).
-            let (entry, hard) = entry(capsule, y, q, bc, a, b, limit, ask);
+            let (entry, hard) = entry(capsule, y, q, bc, a, b, limit, &contact, ask);
             let slid = ask.and(hard.not());
             y = V3::select(slid, entry, y);
             moved = slid.and(differs(y, x)).or(slid.not().and(moved));
@@ -663,9 +704,9 @@ mod tests {
             };
             let (may, entered, pushed) = (contact.may, contact.entered, contact.pushed);
             let (entry, hard) = if capsule {
-                capsule_entry_push(p, q, a, b, F::splat(limit))
+                capsule_entry_push(p, q, a, b, F::splat(limit), &contact)
             } else {
-                (sphere_entry(p, q, c, F::splat(limit)), M::NONE)
+                (sphere_entry(p, q, c, F::splat(limit), &contact), M::NONE)
             };
             #[cfg(target_arch = "x86_64")]
             if std::is_x86_feature_detected!("avx2") {
@@ -751,15 +792,11 @@ mod tests {
         let (p, q) = (V3::<Fa>::of(p), V3::<Fa>::of(q));
         let (a, b, c, limit) = (V3::of(a), V3::of(b), V3::of(c), Fa::splat(limit));
         let (k, (entry, hard)) = if capsule {
-            (
-                capsule_contact(p, q, a, b, limit),
-                capsule_entry_push(p, q, a, b, limit),
-            )
+            let k = capsule_contact(p, q, a, b, limit);
+            (k, capsule_entry_push(p, q, a, b, limit, &k))
         } else {
-            (
-                sphere_contact(p, q, c, limit),
-                (sphere_entry(p, q, c, limit), <Fa as Lane>::M::NONE),
-            )
+            let k = sphere_contact(p, q, c, limit);
+            (k, (sphere_entry(p, q, c, limit, &k), <Fa as Lane>::M::NONE))
         };
         (k.may.m(), k.entered.m(), k.pushed.f(), entry.f(), hard.m())
     }

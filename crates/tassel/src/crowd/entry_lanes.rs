@@ -15,10 +15,9 @@
 
 #[cfg(target_arch = "x86_64")]
 use super::avx::Fa;
-use super::chain_step::entry_radius_lanes;
-use super::lanes::{closest_params_segment_segment, closest_point_on_segment, Lane, F, LANES};
+use super::chain_step::{entry_radius_lanes, LaneContact};
+use super::lanes::{closest_point_on_segment, Lane, F, LANES};
 use super::lanes::{Mask, M, V3};
-use glam::Vec3;
 
 /// One `f64` per lane.
 #[derive(Clone, Copy)]
@@ -246,7 +245,13 @@ fn slide<T: Lane>(contact: V3<T>, p: V3<T>, n: V3<T>) -> V3<T> {
 /// (`center`, `limit`): stopped where it met the entry surface, slid on, then kept
 /// outside. For the lanes [`super::chain_step::sphere_contact`] found `entered`.
 #[inline(always)]
-pub(super) fn sphere_entry<T: Lane>(p: V3<T>, prev: V3<T>, center: V3<T>, limit: T) -> V3<T> {
+pub(super) fn sphere_entry<T: Lane>(
+    p: V3<T>,
+    prev: V3<T>,
+    center: V3<T>,
+    limit: T,
+    contact: &LaneContact<T>,
+) -> V3<T> {
     let inner = entry_radius_lanes(limit);
     let inner2 = inner * inner;
     let (o, v) = (prev - center, p - prev);
@@ -254,9 +259,10 @@ pub(super) fn sphere_entry<T: Lane>(p: V3<T>, prev: V3<T>, center: V3<T>, limit:
     let zero = T::splat(0.0);
     let disc = (ov * ov - vv * (o.dot(o) - inner2)).max(zero);
     let t = T::select(vv.gt(zero), ((-ov - disc.sqrt()) / vv).clamp01(), zero);
-    let contact = prev + v * t;
-    let n = (contact - center).normalize_or(o.normalize_or(V3::splat(Vec3::Y)));
-    let slid = slide(contact, p, n);
+    let at = prev + v * t;
+    // The fallback `(prev - center).normalize_or(Y)`, as the contact computed it.
+    let n = (at - center).normalize_or(contact.fallback);
+    let slid = slide(at, p, n);
     outside_sphere(slid, center, limit, n)
 }
 
@@ -282,7 +288,8 @@ fn outside_capsule<T: Lane>(p: V3<T>, a: V3<T>, b: V3<T>, limit: T, fallback: V3
 /// `f64`), slid on, then kept outside. For the lanes
 /// [`super::chain_step::capsule_contact`] found `entered`; also returns the lanes whose
 /// closed form found no root (`hard`: the scalar function bisects there), whose point is
-/// not answered.
+/// not answered. The step's start's distance from the axis, the share of the step at
+/// its closest approach and the fallback direction are `contact`'s (the same operations).
 #[inline(always)]
 pub(super) fn capsule_entry_push<T: Lane>(
     p: V3<T>,
@@ -290,19 +297,17 @@ pub(super) fn capsule_entry_push<T: Lane>(
     a: V3<T>,
     b: V3<T>,
     limit: T,
+    contact: &LaneContact<T>,
 ) -> (V3<T>, T::M) {
     let inner = entry_radius_lanes(limit);
-    let from_axis = prev - closest_point_on_segment(prev, a, b);
-    let prev_dist = from_axis.length();
-    let prev_fallback = from_axis.normalize_or((b - a).any_orthonormal());
-    let (s, _) = closest_params_segment_segment(prev, p, a, b);
+    let (prev_dist, prev_fallback, s) = (contact.prev_dist, contact.fallback, contact.along);
     let (t, found) = capsule_entry(prev.f(), (p - prev).f(), a.f(), b.f(), inner.f());
     let beyond = inner.lt(prev_dist);
     let lo = T::select(beyond, min_f(T::of(t), s), T::splat(0.0));
     let hard = beyond.and(<T::M as Mask>::of(found).not());
-    let contact = prev + (p - prev) * lo;
-    let n = (contact - closest_point_on_segment(contact, a, b)).normalize_or(prev_fallback);
-    let slid = slide(contact, p, n);
+    let at = prev + (p - prev) * lo;
+    let n = (at - closest_point_on_segment(at, a, b)).normalize_or(prev_fallback);
+    let slid = slide(at, p, n);
     (outside_capsule(slid, a, b, limit, n), hard)
 }
 
@@ -320,6 +325,7 @@ pub(super) fn entry<T: Lane>(
     a: V3<T>,
     b: V3<T>,
     limit: T,
+    contact: &LaneContact<T>,
     need: T::M,
 ) -> (V3<T>, T::M) {
     let args = (
@@ -329,6 +335,7 @@ pub(super) fn entry<T: Lane>(
         a.f(),
         b.f(),
         limit.f(),
+        contact.f(),
         need.m(),
     );
     #[cfg(target_arch = "x86_64")]
@@ -344,7 +351,7 @@ pub(super) fn entry<T: Lane>(
 }
 
 /// [`entry`]'s arguments in the portable lane type.
-type EntryArgs = (V3, V3, V3, V3, V3, F, M);
+type EntryArgs = (V3, V3, V3, V3, V3, F, LaneContact<F>, M);
 
 #[inline(never)]
 fn entry_portable(capsule: bool, args: EntryArgs) -> (V3, M) {
@@ -359,13 +366,20 @@ fn entry_avx2(capsule: bool, args: EntryArgs) -> (V3, M) {
 }
 
 #[inline(always)]
-fn entry_in<T: Lane>(capsule: bool, (p, prev, center, a, b, limit, need): EntryArgs) -> (V3, M) {
+fn entry_in<T: Lane>(
+    capsule: bool,
+    (p, prev, center, a, b, limit, contact, need): EntryArgs,
+) -> (V3, M) {
     let (p, prev, limit) = (V3::<T>::of(p), V3::<T>::of(prev), T::of(limit));
+    let contact = LaneContact::<T>::of(&contact);
     if capsule {
         let (a, b) = (V3::<T>::of(a), V3::<T>::of(b));
-        let (e, h) = capsule_entry_push(p, prev, a, b, limit);
+        let (e, h) = capsule_entry_push(p, prev, a, b, limit, &contact);
         (e.f(), h.and(<T::M as Mask>::of(need)).m())
     } else {
-        (sphere_entry(p, prev, V3::of(center), limit).f(), M::NONE)
+        (
+            sphere_entry(p, prev, V3::of(center), limit, &contact).f(),
+            M::NONE,
+        )
     }
 }
