@@ -20,7 +20,7 @@ use crate::dynamics::chain::job::{
     chain_rng, gravity_cs, motion_cs, place_colliders, slerp_angle, wind_cs,
 };
 use crate::dynamics::chain::step::gravity_step;
-use crate::dynamics::chain::{ChainSettings, ClassicGravity, TimeMode};
+use crate::dynamics::chain::{ChainSettings, ClassicGravity, PlanarAxis, TimeMode};
 use crate::dynamics::path::CharacterPath;
 use crate::error::{Error, Result};
 use crate::math::Transform;
@@ -214,8 +214,9 @@ struct Scratch {
     /// The animated local rotation per joint, all lanes side by side.
     lane_local_rotations: Vec<Q>,
     component: Trs,
-    /// This frame's animated targets and planar normals per point, colliders lane after
-    /// lane, and the colliders' broad-phase spheres.
+    /// This frame's animated targets and planar normals per point (a normal only for the
+    /// points of chains with a planar constraint: no other step reads one), colliders
+    /// lane after lane, and the colliders' broad-phase spheres.
     targets: Vec<V3>,
     normals: Vec<V3>,
     colliders: Vec<PlacedCollider>,
@@ -983,8 +984,9 @@ fn model_pose_lanes<T: Lane>(
     (bad.m(), sure.not().m())
 }
 
-/// `gather_targets`' animated targets and planar normals per point, for every lane at
-/// once from the lane pose, by its operations (each lane gets the scalar function's bits).
+/// `gather_targets`' animated targets and planar normals per point (the normals of chains
+/// with a planar constraint only), for every lane at once from the lane pose, by its
+/// operations (each lane gets the scalar function's bits).
 #[inline(always)]
 fn targets_lanes<T: Lane>(sk: &Skeleton, rig: &ChainRig, s: &mut Scratch) {
     let models = &s.lane_models;
@@ -1004,7 +1006,8 @@ fn targets_lanes<T: Lane>(sk: &Skeleton, rig: &ChainRig, s: &mut Scratch) {
         } else {
             models[j as usize].t
         };
-        if parent != NONE {
+        // The planar normal only where a step reads it (its chain's constraint is on).
+        if parent != NONE && rig.is_planar(p) {
             let pj = rig.joint[parent as usize] as usize;
             let axis = V3::splat(rig.planar_local_axis(p));
             s.normals[p] = Q::<T>::of(models[pj].r).mul_vec3(axis).f();
@@ -1436,9 +1439,14 @@ impl Ctx<'_> {
             }));
             for p in chain.points.clone() {
                 s.step_targets[p] = pack.prev_targets[p].lerp(s.targets[p], w);
-                s.step_normals[p] = pack.prev_normals[p]
-                    .lerp(s.normals[p], w)
-                    .normalize_or(s.normals[p]);
+            }
+            // The normals only where the step reads them.
+            if set.planar_constraint != PlanarAxis::None {
+                for p in chain.points.clone() {
+                    s.step_normals[p] = pack.prev_normals[p]
+                        .lerp(s.normals[p], w)
+                        .normalize_or(s.normals[p]);
+                }
             }
             // With one character in every lane, a lane at the same share of the frame as
             // the last lane placed gets that lane's placement.

@@ -74,6 +74,14 @@ impl ChainRig {
         }
     }
 
+    /// Whether point `p`'s chain has a planar constraint (its steps read its normal).
+    pub(crate) fn is_planar(&self, p: usize) -> bool {
+        self.chains[self.chain_of[p] as usize]
+            .settings
+            .planar_constraint
+            != super::settings::PlanarAxis::None
+    }
+
     /// Compiles `rig` for `skeleton`: resolves bone names, collects each chain's points
     /// depth-first, evaluates the parameter curves. Errors name the chain or collider.
     pub fn new(skeleton: &Skeleton, rig: &RigSettings) -> Result<Self> {
