@@ -181,6 +181,55 @@ pub(super) fn sphere_contact<T: Lane>(
     }
 }
 
+/// [`sphere_contact`] for a point that did not step (`prev` is `p`, as the output pass
+/// asks): the same answer without the entry test, which cannot pass (the step's closest
+/// point to the centre is `p` itself, computed by the same operations as the start's).
+#[inline(always)]
+pub(super) fn sphere_contact_still<T: Lane>(p: V3<T>, center: V3<T>, limit: T) -> LaneContact<T> {
+    let d = p - center;
+    let fallback = d.normalize_or(V3::splat(Vec3::Y));
+    LaneContact {
+        may: d.dot(d).lt(limit * limit),
+        entered: <T::M as Mask>::NONE,
+        pushed: center + d.normalize_or(fallback) * limit,
+        fallback,
+        along: T::splat(0.0),
+        prev_dist: T::splat(0.0),
+    }
+}
+
+/// [`capsule_contact`] for a point that did not step (`prev` is `p`): the step's closest
+/// approach to the axis is then `p`'s closest point on it, computed by the same
+/// operations as `p`'s own (`closest_params_segment_segment` of a zero-length step takes
+/// its share along the axis as `closest_point_on_segment` does), so it is not computed
+/// again; but where an axis is shorter than 1e-6 (the two part ways), it is.
+#[inline(always)]
+pub(super) fn capsule_contact_still<T: Lane>(
+    p: V3<T>,
+    a: V3<T>,
+    b: V3<T>,
+    limit: T,
+) -> LaneContact<T> {
+    let ab = b - a;
+    if ab.dot(ab).le(T::splat(1e-12)).any() {
+        return capsule_contact(p, p, a, b, limit);
+    }
+    let inner = entry_radius_lanes(limit);
+    let c = closest_point_on_segment(p, a, b);
+    let d = p - c;
+    let (dist2, dist) = (d.dot(d), d.length());
+    let entered = inner.le(dist).and(dist2.lt(inner * inner));
+    let fallback = d.normalize_or(ab.any_orthonormal());
+    LaneContact {
+        may: entered.or(dist2.lt(limit * limit)),
+        entered,
+        pushed: c + d.normalize_or(fallback) * limit,
+        fallback,
+        along: T::splat(0.0),
+        prev_dist: dist,
+    }
+}
+
 /// [`crate::collide::entry_radius`] per lane: `limit` less the contact tolerance (1e-4 of it), never
 /// below 0, with the scalar function's operations.
 #[inline(always)]
@@ -368,14 +417,23 @@ fn collide<T: Lane>(
         // own narrow phase (a push, or the swept entry); other shapes, and a capsule
         // graze the lanes cannot answer, from the scalar one.
         let (a, b) = (V3::of(bound.a), V3::of(bound.b));
+        // (Without a step, `q` is `y`: the contacts for a point that did not step.)
         let contact = match shape.decision {
             Decision::Sphere(radius) => {
                 let limit = T::splat(radius + r);
-                Some((sphere_contact(y, q, bc, limit), limit, false))
+                let contact = match prev {
+                    Some(_) => sphere_contact(y, q, bc, limit),
+                    None => sphere_contact_still(y, bc, limit),
+                };
+                Some((contact, limit, false))
             }
             Decision::Capsule(radius) => {
                 let limit = T::splat(radius + r);
-                Some((capsule_contact(y, q, a, b, limit), limit, true))
+                let contact = match prev {
+                    Some(_) => capsule_contact(y, q, a, b, limit),
+                    None => capsule_contact_still(y, a, b, limit),
+                };
+                Some((contact, limit, true))
             }
             Decision::Scalar => None,
         };
@@ -635,6 +693,80 @@ mod tests {
     /// and end inside, on and outside the shapes, graze them and pass through them; every
     /// answer must occur often (a decision that always asks, or never, fails). In `F` and,
     /// where the CPU has it, in the AVX lane type.
+    /// The contacts of a point that did not step ([`sphere_contact_still`],
+    /// [`capsule_contact_still`]) are the contacts of a zero-length step, bit for bit in
+    /// every field: points around spheres and capsules (long, of no length, and shorter
+    /// than the 1e-6 where the two part ways), on the surface, on the axis and at the
+    /// entry radius give or take a rounding.
+    #[test]
+    fn still_contact_is_the_contact_of_a_zero_step() {
+        let mut rng = SplitMix64::new(17);
+        let mut u = |lo: f32, hi: f32| rng.range_f32(lo, hi);
+        let m = |m: M| m.0;
+        let v = |v: V3| [v.x, v.y, v.z].map(|c| c.0.map(f32::to_bits));
+        let f = |f: F| f.0.map(f32::to_bits);
+        let (mut may, mut short) = (0, 0);
+        for round in 0..4000 {
+            let capsule = round % 2 == 1;
+            let length = match round % 8 {
+                1 => 0.0,
+                3 => 1e-7,
+                _ => u(0.0, 0.3),
+            };
+            let limit = F(std::array::from_fn(|_| u(0.01, 0.12)));
+            let (mut p, mut a, mut b, mut c) = (V3::ZERO, V3::ZERO, V3::ZERO, V3::ZERO);
+            for l in 0..LANES {
+                let centre = Vec3::new(u(-1.0, 1.0), u(-1.0, 1.0), u(-1.0, 1.0));
+                let axis =
+                    Vec3::new(u(-1.0, 1.0), u(-1.0, 1.0), u(-1.0, 1.0)).normalize_or(Vec3::Y);
+                let (ea, eb) = (centre - axis * 0.5 * length, centre + axis * 0.5 * length);
+                let out = axis.any_orthonormal_vector();
+                let inner = limit.0[l] - 1e-4 * limit.0[l];
+                let along = centre + axis * length * u(-0.7, 0.7);
+                let at = match (round + l) % 5 {
+                    0 => along + out * limit.0[l],
+                    1 => along + out * inner * (1.0 + u(-1e-6, 1e-6)),
+                    2 => along,
+                    _ => along + out * u(0.0, 2.0 * limit.0[l]),
+                };
+                p.set(l, at);
+                a.set(l, ea);
+                b.set(l, eb);
+                c.set(l, centre);
+            }
+            let (still, step) = if capsule {
+                (
+                    capsule_contact_still(p, a, b, limit),
+                    capsule_contact(p, p, a, b, limit),
+                )
+            } else {
+                (
+                    sphere_contact_still(p, c, limit),
+                    sphere_contact(p, p, c, limit),
+                )
+            };
+            assert_eq!(m(still.may), m(step.may), "round {round}: may");
+            assert_eq!(m(still.entered), m(step.entered), "round {round}: entered");
+            assert_eq!(v(still.pushed), v(step.pushed), "round {round}: pushed");
+            assert_eq!(
+                v(still.fallback),
+                v(step.fallback),
+                "round {round}: fallback"
+            );
+            if capsule {
+                assert_eq!(f(still.along), f(step.along), "round {round}: along");
+                assert_eq!(
+                    f(still.prev_dist),
+                    f(step.prev_dist),
+                    "round {round}: start"
+                );
+            }
+            may += still.may.0.iter().filter(|&&x| x != 0).count();
+            short += usize::from(capsule && length == 1e-7);
+        }
+        assert!(may > 4000 && short > 200, "{may} {short}");
+    }
+
     #[test]
     fn lane_contact_gives_the_narrow_phase_bits() {
         let mut rng = SplitMix64::new(5);
