@@ -1088,7 +1088,8 @@ impl Ctx<'_> {
     }
 
     /// [`model_pose_lanes`] and [`targets_lanes`] with AVX2 where the CPU has it (as
-    /// [`Ctx::step`]): the lanes with a non-finite model transform.
+    /// [`Ctx::step`]): the lanes with a non-finite model transform, and the lanes whose
+    /// locals the lanes could not vouch for (as `model_pose_lanes`).
     fn model_pose(&self, locals: &[&[Transform]; LANES], s: &mut Scratch, count: usize) -> (M, M) {
         #[cfg(target_arch = "x86_64")]
         if self.avx2 && std::arch::is_x86_feature_detected!("avx2") {

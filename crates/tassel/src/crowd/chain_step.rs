@@ -106,8 +106,8 @@ impl LaneShape {
 
 /// A keep-out sphere's or capsule's answer for a point per lane, computed with the
 /// narrow phase's own operations: which lanes it may move (the others get their point
-/// back unchanged), which of those the step *entered* (the swept contact, left to the
-/// scalar narrow phase: rarer, and with a root finding of its own), and for the lanes it
+/// back unchanged), which of those the step *entered* (the swept contact, answered by
+/// [`super::entry_lanes`]: rarer, and with a root finding of its own), and for the lanes it
 /// may move without an entry, the point it gives back (pushed out to the surface); and
 /// what the swept entry computes again ([`super::entry_lanes`] takes it from here).
 #[derive(Clone, Copy)]
@@ -685,14 +685,6 @@ mod tests {
     use crate::math::Transform;
     use glam::Quat;
 
-    /// The lanes' contact for keep-out spheres and capsules gives the scalar narrow
-    /// phase's bits: a lane it turns away gets its point back from the scalar narrow
-    /// phase unchanged, a lane it pushes without an entry gets the point the scalar
-    /// narrow phase gives, and so does a lane whose step entered the shape (the swept
-    /// entry of `entry_lanes`, but for the capsule lanes it reports `hard`). Steps start
-    /// and end inside, on and outside the shapes, graze them and pass through them; every
-    /// answer must occur often (a decision that always asks, or never, fails). In `F` and,
-    /// where the CPU has it, in the AVX lane type.
     /// The contacts of a point that did not step ([`sphere_contact_still`],
     /// [`capsule_contact_still`]) are the contacts of a zero-length step, bit for bit in
     /// every field: points around spheres and capsules (long, of no length, and shorter
@@ -767,6 +759,14 @@ mod tests {
         assert!(may > 4000 && short > 200, "{may} {short}");
     }
 
+    /// The lanes' contact for keep-out spheres and capsules gives the scalar narrow
+    /// phase's bits: a lane it turns away gets its point back from the scalar narrow
+    /// phase unchanged, a lane it pushes without an entry gets the point the scalar
+    /// narrow phase gives, and so does a lane whose step entered the shape (the swept
+    /// entry of `entry_lanes`, but for the capsule lanes it reports `hard`). Steps start
+    /// and end inside, on and outside the shapes, graze them and pass through them; every
+    /// answer must occur often (a decision that always asks, or never, fails). In `F` and,
+    /// where the CPU has it, in the AVX lane type.
     #[test]
     fn lane_contact_gives_the_narrow_phase_bits() {
         let mut rng = SplitMix64::new(5);
