@@ -253,13 +253,18 @@ pub(super) fn capsule_contact<T: Lane>(
     let inner = entry_radius_lanes(limit);
     let from_axis = prev - closest_point_on_segment(prev, a, b);
     let prev_dist = from_axis.length();
-    let (s, t) = closest_params_segment_segment(prev, p, a, b);
-    let on_path = prev + (p - prev) * s;
-    let on_axis = a + (b - a) * t;
-    let gap = on_path - on_axis;
-    let entered = inner.le(prev_dist).and(gap.dot(gap).lt(inner * inner));
     let c = closest_point_on_segment(p, a, b);
     let d = p - c;
+    // The step's closest approach to the axis only where an entry is possible.
+    let (s, entered) = if entry_possible(p, prev, a, b, inner, prev_dist, d).any() {
+        let (s, t) = closest_params_segment_segment(prev, p, a, b);
+        let on_path = prev + (p - prev) * s;
+        let on_axis = a + (b - a) * t;
+        let gap = on_path - on_axis;
+        (s, inner.le(prev_dist).and(gap.dot(gap).lt(inner * inner)))
+    } else {
+        (T::splat(0.0), <T::M as Mask>::NONE)
+    };
     // `outside_capsule(p, a, b, limit, prev_fallback())` where it pushes.
     let fallback = from_axis.normalize_or((b - a).any_orthonormal());
     LaneContact {
@@ -270,6 +275,36 @@ pub(super) fn capsule_contact<T: Lane>(
         along: s,
         prev_dist,
     }
+}
+
+/// The lanes where the step `prev` → `p` may enter the capsule `a`–`b` (entry radius
+/// `inner`), as [`capsule_contact`] decides it: its start at or beyond `inner`
+/// (`prev_dist`, its distance from the axis), and its path not provably farther from the
+/// axis than `inner`. The path's distance is at least `(prev_dist + |d| - |p - prev|) / 2`
+/// (`d`: `p` from its closest point on the axis; the distance to a segment changes no
+/// faster than the point moves); "provably" keeps a margin of 1e-5 of the largest
+/// coordinate, far above the rounding of both this bound and the closest approach's own
+/// computation (whose points lie within a few ulps of the path and the axis). NaN: possible.
+#[inline(always)]
+pub(super) fn entry_possible<T: Lane>(
+    p: V3<T>,
+    prev: V3<T>,
+    a: V3<T>,
+    b: V3<T>,
+    inner: T,
+    prev_dist: T,
+    d: V3<T>,
+) -> T::M {
+    let lb = (prev_dist + d.length() - (p - prev).length()) * T::splat(0.5);
+    // The largest coordinate's size (a NaN gives a NaN bound: possible).
+    let max = |x: T, y: T| T::select(x.gt(y), x, y);
+    let big = |v: V3<T>| {
+        let v = v.abs();
+        max(max(v.x, v.y), v.z)
+    };
+    let m = max(max(big(p), big(prev)), max(big(a), big(b)));
+    let bound = inner + T::splat(1e-5) * (m + inner + T::splat(1.0));
+    inner.le(prev_dist).and(lb.gt(bound).not())
 }
 
 /// Everything one lane step reads besides the rig and the points (as
@@ -757,6 +792,90 @@ mod tests {
             short += usize::from(capsule && length == 1e-7);
         }
         assert!(may > 4000 && short > 200, "{may} {short}");
+    }
+
+    /// [`entry_possible`] never turns away a step whose closest approach to the capsule's
+    /// axis (computed as [`capsule_contact`] computes it when it does not skip) is inside
+    /// the entry radius: steps that graze the entry surface at ± 1e-6 of it, pass
+    /// through, start on it and pass far, around capsules of every length (none, 1e-7,
+    /// ordinary) placed up to 1e5 from the origin. It must also turn many away.
+    #[test]
+    fn entry_possible_keeps_every_entry() {
+        let mut rng = SplitMix64::new(29);
+        let mut u = |lo: f32, hi: f32| rng.range_f32(lo, hi);
+        let (mut entries, mut turned_away) = (0, 0);
+        for round in 0..20_000 {
+            let far = [0.0, 1.0, 100.0, 1e4, 1e5][round % 5];
+            let length = match round % 7 {
+                1 => 0.0,
+                3 => 1e-7,
+                _ => u(0.0, 0.3),
+            };
+            let limit = F(std::array::from_fn(|_| u(0.005, 0.12)));
+            let (mut p, mut q, mut a, mut b) = (V3::ZERO, V3::ZERO, V3::ZERO, V3::ZERO);
+            for l in 0..LANES {
+                let centre = Vec3::new(u(-1.0, 1.0), u(-1.0, 1.0), u(-1.0, 1.0)) * far;
+                let axis =
+                    Vec3::new(u(-1.0, 1.0), u(-1.0, 1.0), u(-1.0, 1.0)).normalize_or(Vec3::Y);
+                let (ea, eb) = (centre - axis * 0.5 * length, centre + axis * 0.5 * length);
+                let out = axis.any_orthonormal_vector();
+                let side = axis.cross(out);
+                let inner = limit.0[l] - 1e-4 * limit.0[l];
+                let along = centre + axis * length * u(-0.7, 0.7);
+                let k = u(0.001, 0.3);
+                let (from, to) = match (round + l) % 4 {
+                    // A graze: past a point at the entry radius give or take a rounding.
+                    0 => {
+                        let g = along + out * inner * (1.0 + u(-2e-6, 2e-6));
+                        (g - side * k, g + side * k * u(0.5, 1.5))
+                    }
+                    // Through.
+                    1 => (along + out * u(1.0, 3.0) * limit.0[l], along - out * k),
+                    // From the surface, any way.
+                    2 => {
+                        let s = along + out * limit.0[l];
+                        let dir = Vec3::new(u(-1.0, 1.0), u(-1.0, 1.0), u(-1.0, 1.0));
+                        (s, s + dir * k)
+                    }
+                    // Anywhere near.
+                    _ => {
+                        let r = 4.0 * limit.0[l] + length;
+                        (
+                            centre + Vec3::new(u(-r, r), u(-r, r), u(-r, r)),
+                            centre + Vec3::new(u(-r, r), u(-r, r), u(-r, r)),
+                        )
+                    }
+                };
+                p.set(l, to);
+                q.set(l, from);
+                a.set(l, ea);
+                b.set(l, eb);
+            }
+            let inner = entry_radius_lanes(limit);
+            let prev_dist = (q - closest_point_on_segment(q, a, b)).length();
+            let d = p - closest_point_on_segment(p, a, b);
+            let possible = entry_possible(p, q, a, b, inner, prev_dist, d);
+            let (s, t) = closest_params_segment_segment(q, p, a, b);
+            let gap = (q + (p - q) * s) - (a + (b - a) * t);
+            let entered = inner.le(prev_dist).and(gap.dot(gap).lt(inner * inner));
+            for l in 0..LANES {
+                if entered.0[l] != 0 {
+                    entries += 1;
+                    assert!(
+                        possible.0[l] != 0,
+                        "round {round} lane {l}: an entry turned away ({:?} -> {:?})",
+                        q.get(l),
+                        p.get(l)
+                    );
+                } else if possible.0[l] == 0 {
+                    turned_away += 1;
+                }
+            }
+        }
+        assert!(
+            entries > 10_000 && turned_away > 10_000,
+            "{entries} {turned_away}"
+        );
     }
 
     /// The lanes' contact for keep-out spheres and capsules gives the scalar narrow
