@@ -282,9 +282,10 @@ pub(super) fn capsule_contact<T: Lane>(
 /// (`prev_dist`, its distance from the axis), and its path not provably farther from the
 /// axis than `inner`. The path's distance is at least `(prev_dist + |d| - |p - prev|) / 2`
 /// (`d`: `p` from its closest point on the axis; the distance to a segment changes no
-/// faster than the point moves); "provably" keeps a margin of 1e-5 of the largest
-/// coordinate, far above the rounding of both this bound and the closest approach's own
-/// computation (whose points lie within a few ulps of the path and the axis). NaN: possible.
+/// faster than the point moves); "provably" keeps a margin of 1e-5 × (the largest
+/// coordinate's size + `inner` + 1), far above the rounding of both this bound and the
+/// closest approach's own computation (whose points lie within a few ulps of the path
+/// and the axis). NaN: possible.
 #[inline(always)]
 pub(super) fn entry_possible<T: Lane>(
     p: V3<T>,
@@ -796,7 +797,7 @@ mod tests {
 
     /// [`entry_possible`] never turns away a step whose closest approach to the capsule's
     /// axis (computed as [`capsule_contact`] computes it when it does not skip) is inside
-    /// the entry radius: steps that graze the entry surface at ± 1e-6 of it, pass
+    /// the entry radius: steps that graze the entry surface at ± 2e-6 of it, pass
     /// through, start on it and pass far, around capsules of every length (none, 1e-7,
     /// ordinary) placed up to 1e5 from the origin. It must also turn many away.
     #[test]
