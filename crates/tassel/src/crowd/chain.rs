@@ -1007,9 +1007,9 @@ fn targets_lanes<T: Lane>(sk: &Skeleton, rig: &ChainRig, s: &mut Scratch) {
             models[j as usize].t
         };
         // The planar normal only where a step reads it (its chain's constraint is on).
-        if parent != NONE && rig.is_planar(p) {
+        if let (true, Some(axis)) = (parent != NONE, rig.planar_axis(p)) {
             let pj = rig.joint[parent as usize] as usize;
-            let axis = V3::splat(rig.planar_local_axis(p));
+            let axis = V3::splat(axis);
             s.normals[p] = Q::<T>::of(models[pj].r).mul_vec3(axis).f();
         }
     }

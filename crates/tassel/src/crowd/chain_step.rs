@@ -721,6 +721,39 @@ mod tests {
     use crate::math::Transform;
     use glam::Quat;
 
+    /// A random capsule (or sphere, `length` 0) for a contact test: centre within `far`
+    /// of the origin in each coordinate, a random axis, a direction `out` across it, the
+    /// entry radius of `limit` and a random point `along` the axis (near its middle).
+    struct TestCapsule {
+        centre: Vec3,
+        axis: Vec3,
+        a: Vec3,
+        b: Vec3,
+        out: Vec3,
+        inner: f32,
+        along: Vec3,
+    }
+
+    fn random_capsule(
+        u: &mut impl FnMut(f32, f32) -> f32,
+        far: f32,
+        length: f32,
+        limit: f32,
+    ) -> TestCapsule {
+        let centre = Vec3::new(u(-1.0, 1.0), u(-1.0, 1.0), u(-1.0, 1.0)) * far;
+        let axis = Vec3::new(u(-1.0, 1.0), u(-1.0, 1.0), u(-1.0, 1.0)).normalize_or(Vec3::Y);
+        let along = centre + axis * length * u(-0.7, 0.7);
+        TestCapsule {
+            centre,
+            axis,
+            a: centre - axis * 0.5 * length,
+            b: centre + axis * 0.5 * length,
+            out: axis.any_orthonormal_vector(),
+            inner: limit - 1e-4 * limit,
+            along,
+        }
+    }
+
     /// The contacts of a point that did not step ([`sphere_contact_still`],
     /// [`capsule_contact_still`]) are the contacts of a zero-length step, bit for bit in
     /// every field: points around spheres and capsules (long, of no length, and shorter
@@ -744,13 +777,9 @@ mod tests {
             let limit = F(std::array::from_fn(|_| u(0.01, 0.12)));
             let (mut p, mut a, mut b, mut c) = (V3::ZERO, V3::ZERO, V3::ZERO, V3::ZERO);
             for l in 0..LANES {
-                let centre = Vec3::new(u(-1.0, 1.0), u(-1.0, 1.0), u(-1.0, 1.0));
-                let axis =
-                    Vec3::new(u(-1.0, 1.0), u(-1.0, 1.0), u(-1.0, 1.0)).normalize_or(Vec3::Y);
-                let (ea, eb) = (centre - axis * 0.5 * length, centre + axis * 0.5 * length);
-                let out = axis.any_orthonormal_vector();
-                let inner = limit.0[l] - 1e-4 * limit.0[l];
-                let along = centre + axis * length * u(-0.7, 0.7);
+                let k = random_capsule(&mut u, 1.0, length, limit.0[l]);
+                let (centre, ea, eb, out, inner, along) =
+                    (k.centre, k.a, k.b, k.out, k.inner, k.along);
                 let at = match (round + l) % 5 {
                     0 => along + out * limit.0[l],
                     1 => along + out * inner * (1.0 + u(-1e-6, 1e-6)),
@@ -815,14 +844,10 @@ mod tests {
             let limit = F(std::array::from_fn(|_| u(0.005, 0.12)));
             let (mut p, mut q, mut a, mut b) = (V3::ZERO, V3::ZERO, V3::ZERO, V3::ZERO);
             for l in 0..LANES {
-                let centre = Vec3::new(u(-1.0, 1.0), u(-1.0, 1.0), u(-1.0, 1.0)) * far;
-                let axis =
-                    Vec3::new(u(-1.0, 1.0), u(-1.0, 1.0), u(-1.0, 1.0)).normalize_or(Vec3::Y);
-                let (ea, eb) = (centre - axis * 0.5 * length, centre + axis * 0.5 * length);
-                let out = axis.any_orthonormal_vector();
-                let side = axis.cross(out);
-                let inner = limit.0[l] - 1e-4 * limit.0[l];
-                let along = centre + axis * length * u(-0.7, 0.7);
+                let c = random_capsule(&mut u, far, length, limit.0[l]);
+                let (centre, ea, eb, out, inner, along) =
+                    (c.centre, c.a, c.b, c.out, c.inner, c.along);
+                let side = c.axis.cross(out);
                 let k = u(0.001, 0.3);
                 let (from, to) = match (round + l) % 4 {
                     // A graze: past a point at the entry radius give or take a rounding.

@@ -61,25 +61,24 @@ pub struct ChainRig {
 
 impl ChainRig {
     /// The axis, in the parent joint's space, that point `p`'s planar constraint keeps
-    /// its bone perpendicular to (its chain's `planar_constraint`; Y when it has none).
-    pub(crate) fn planar_local_axis(&self, p: usize) -> glam::Vec3 {
+    /// its bone perpendicular to (its chain's `planar_constraint`), or `None` when its
+    /// chain has none (then no step reads a normal of its).
+    pub(crate) fn planar_axis(&self, p: usize) -> Option<glam::Vec3> {
         use super::settings::PlanarAxis;
         match self.chains[self.chain_of[p] as usize]
             .settings
             .planar_constraint
         {
-            PlanarAxis::X => glam::Vec3::X,
-            PlanarAxis::Z => glam::Vec3::Z,
-            _ => glam::Vec3::Y,
+            PlanarAxis::None => None,
+            PlanarAxis::X => Some(glam::Vec3::X),
+            PlanarAxis::Y => Some(glam::Vec3::Y),
+            PlanarAxis::Z => Some(glam::Vec3::Z),
         }
     }
 
-    /// Whether point `p`'s chain has a planar constraint (its steps read its normal).
-    pub(crate) fn is_planar(&self, p: usize) -> bool {
-        self.chains[self.chain_of[p] as usize]
-            .settings
-            .planar_constraint
-            != super::settings::PlanarAxis::None
+    /// [`ChainRig::planar_axis`], Y for a chain without a planar constraint.
+    pub(crate) fn planar_local_axis(&self, p: usize) -> glam::Vec3 {
+        self.planar_axis(p).unwrap_or(glam::Vec3::Y)
     }
 
     /// Compiles `rig` for `skeleton`: resolves bone names, collects each chain's points
