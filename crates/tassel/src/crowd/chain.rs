@@ -1459,6 +1459,14 @@ impl Ctx<'_> {
                 for l in 0..LANES {
                     let at = l * k_all + c;
                     if active.0[l] != 0 && s.step_placed_at[at].to_bits() != w.0[l].to_bits() {
+                        if w.0[l] >= 1.0 {
+                            // The frame's own placement (`PlacedCollider::lerp` from 1 on),
+                            // and so its bound.
+                            s.step_colliders[at] = s.colliders[at];
+                            s.step_bounds[c].set_lane_from(l, &s.bounds[c]);
+                            s.step_placed_at[at] = w.0[l];
+                            continue;
+                        }
                         match same(l, last) {
                             Some(k) => {
                                 s.step_colliders[at] = s.step_colliders[k * k_all + c];

@@ -49,6 +49,15 @@ impl Bound {
         self.b.set(to, self.b.get(from));
     }
 
+    /// Lane `l` as lane `l` of `other`.
+    #[inline]
+    pub(super) fn set_lane_from(&mut self, l: usize, other: &Bound) {
+        self.c.set(l, other.c.get(l));
+        self.w.0[l] = other.w.0[l];
+        self.a.set(l, other.a.get(l));
+        self.b.set(l, other.b.get(l));
+    }
+
     /// Lane `l` from its placed collider.
     #[inline]
     pub(super) fn set(&mut self, l: usize, c: &PlacedCollider) {
