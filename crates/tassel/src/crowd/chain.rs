@@ -769,6 +769,14 @@ fn motion_settings(s: &ChainSettings) -> (bool, Vec3, Vec3, f32, ClassicGravity)
     )
 }
 
+/// The ten lane fields of a transform (translation, rotation, scale).
+#[inline(always)]
+fn fields(a: &Trs) -> [&F; 10] {
+    [
+        &a.t.x, &a.t.y, &a.t.z, &a.r.x, &a.r.y, &a.r.z, &a.r.w, &a.s.x, &a.s.y, &a.s.z,
+    ]
+}
+
 /// Whether the lanes `m` of `a` and `b` hold the same bits.
 #[inline]
 fn same_lanes(a: &Trs, b: &Trs, m: M) -> bool {
@@ -778,16 +786,10 @@ fn same_lanes(a: &Trs, b: &Trs, m: M) -> bool {
             d | ((x.0[l].to_bits() ^ y.0[l].to_bits()) & m.0[l])
         })
     };
-    let d = differ(&a.t.x, &b.t.x)
-        | differ(&a.t.y, &b.t.y)
-        | differ(&a.t.z, &b.t.z)
-        | differ(&a.r.x, &b.r.x)
-        | differ(&a.r.y, &b.r.y)
-        | differ(&a.r.z, &b.r.z)
-        | differ(&a.r.w, &b.r.w)
-        | differ(&a.s.x, &b.s.x)
-        | differ(&a.s.y, &b.s.y)
-        | differ(&a.s.z, &b.s.z);
+    let d = fields(a)
+        .iter()
+        .zip(fields(b))
+        .fold(0, |d, (x, y)| d | differ(x, y));
     d == 0
 }
 
@@ -856,6 +858,28 @@ fn motion(
         wind_on: M::NONE,
     };
     let mut wind = [false; LANES];
+    // One character in every lane, every active lane between the same transforms (bit
+    // for bit) as the first: that lane's motion is every lane's (the same function of
+    // the same values).
+    if let Some(k) = (0..LANES).find(|&l| active.0[l] != 0).filter(|&k| {
+        shared && lanes_as(to, k, active) && from.is_none_or(|a| lanes_as(a, k, active))
+    }) {
+        let b = to.get(k);
+        let (m, r) = match from {
+            Some(a) => motion_cs(&a.get(k), &b),
+            None => (Vec3::ZERO, Quat::IDENTITY),
+        };
+        let g = gravity_step(s, gravity_cs(s, &b), dt, fixed);
+        let w = wind_cs(s, &b);
+        let on = s.wind.speed > 0.0 && w != Vec3::ZERO;
+        let pick = |v: Vec3, zero: &V3| V3::select(active, V3::splat(v), *zero);
+        out.move_cs = pick(m, &out.move_cs);
+        out.rotate_cs = Q::select(active, Q::splat(r), out.rotate_cs);
+        out.gravity_step = pick(g, &out.gravity_step);
+        out.wind_cs = pick(w, &out.wind_cs);
+        out.wind_on = if on { active } else { M::NONE };
+        return out;
+    }
     let mut last: Option<usize> = None;
     for l in 0..LANES {
         if active.0[l] == 0 {
@@ -891,6 +915,17 @@ fn motion(
     }
     out.wind_on = M::from_bools(wind);
     out
+}
+
+/// Whether every lane of `m` in `a` holds lane `k`'s bits.
+#[inline]
+fn lanes_as(a: &Trs, k: usize, m: M) -> bool {
+    // As `same_lanes`, against lane `k` in every lane.
+    let differ = |x: &F| {
+        let at_k = x.0[k].to_bits();
+        (0..LANES).fold(0, |d, l| d | ((x.0[l].to_bits() ^ at_k) & m.0[l]))
+    };
+    fields(a).iter().fold(0, |d, x| d | differ(x)) == 0
 }
 
 /// Whether two transforms are the same bits.
@@ -1623,5 +1658,83 @@ mod tests {
             }
         }
         assert!(memo.hits > 1000, "{}", memo.hits);
+    }
+
+    /// With one character in every lane (`shared`), the motion is each lane's own, computed
+    /// lane by lane without sharing, in every lane (the inactive ones keep the empty
+    /// motion): whether every active lane stepped between the same transforms (one lane's
+    /// motion for all) or one differs, by a transform or by a single bit.
+    #[test]
+    fn shared_motion_is_each_lanes_own() {
+        let mut rng = SplitMix64::new(5);
+        let mut u = |lo: f32, hi: f32| rng.range_f32(lo, hi);
+        let mut settings = ChainSettings::default();
+        settings.wind.speed = 0.5;
+        settings.wind.direction = Vec3::X;
+        let bits = |m: &Motion, l: usize| {
+            let v = |v: Vec3| v.to_array().map(f32::to_bits);
+            (
+                v(m.move_cs.get(l)),
+                m.rotate_cs.get(l).to_array().map(f32::to_bits),
+                v(m.gravity_step.get(l)),
+                v(m.wind_cs.get(l)),
+                m.wind_on.0[l],
+            )
+        };
+        let (mut all_same, mut one_differs) = (0, 0);
+        for round in 0..3000 {
+            let mut t = || {
+                Transform::from_translation_rotation(
+                    Vec3::new(u(-1.0, 1.0), u(-1.0, 1.0), u(-1.0, 1.0)),
+                    Quat::from_euler(glam::EulerRot::XYZ, u(-3.0, 3.0), u(-3.0, 3.0), 0.0),
+                )
+            };
+            let (a, b, other) = (t(), t(), t());
+            let mut from = Trs::splat(&a);
+            let mut to = Trs::splat(&b);
+            let l = (u(0.0, 8.0) as usize).min(LANES - 1);
+            match round % 4 {
+                0 => {}
+                1 => from.set(l, &other),
+                2 => to.set(l, &other),
+                _ => {
+                    // One bit of one lane's rotation.
+                    let mut r = b;
+                    r.rotation = Quat::from_xyzw(
+                        f32::from_bits(r.rotation.x.to_bits() ^ 1),
+                        r.rotation.y,
+                        r.rotation.z,
+                        r.rotation.w,
+                    );
+                    to.set(l, &r);
+                }
+            }
+            let active = M(std::array::from_fn(|k| {
+                if k == l || u(0.0, 1.0) < 0.7 {
+                    !0
+                } else {
+                    0
+                }
+            }));
+            let has_from = round % 8 < 6;
+            let f = has_from.then_some(&from);
+            let differs = round % 4 != 0
+                && (round % 4 != 1 || has_from)
+                && (0..LANES).any(|k| k != l && active.0[k] != 0);
+            if differs {
+                one_differs += 1;
+            } else {
+                all_same += 1;
+            }
+            let got = motion(&settings, f, &to, 1.0 / 60.0, true, active, true);
+            let want = motion(&settings, f, &to, 1.0 / 60.0, true, active, false);
+            for k in 0..LANES {
+                assert_eq!(bits(&got, k), bits(&want, k), "round {round} lane {k}");
+            }
+        }
+        assert!(
+            all_same > 500 && one_differs > 1500,
+            "{all_same} {one_differs}"
+        );
     }
 }

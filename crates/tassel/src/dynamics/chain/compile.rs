@@ -76,11 +76,6 @@ impl ChainRig {
         }
     }
 
-    /// [`ChainRig::planar_axis`], Y for a chain without a planar constraint.
-    pub(crate) fn planar_local_axis(&self, p: usize) -> glam::Vec3 {
-        self.planar_axis(p).unwrap_or(glam::Vec3::Y)
-    }
-
     /// Compiles `rig` for `skeleton`: resolves bone names, collects each chain's points
     /// depth-first, evaluates the parameter curves. Errors name the chain or collider.
     pub fn new(skeleton: &Skeleton, rig: &RigSettings) -> Result<Self> {

@@ -355,7 +355,8 @@ impl ChainJob<'_> {
     }
 }
 
-/// Animated targets, planar normals and placed colliders from the animated model pose.
+/// Animated targets, planar normals (of the chains with a planar constraint) and placed
+/// colliders from the animated model pose.
 pub(crate) fn gather_targets(
     sk: &Skeleton,
     rig: &ChainRig,
@@ -381,9 +382,11 @@ pub(crate) fn gather_targets(
         } else {
             models[j as usize].translation
         };
-        if parent != NONE {
+        // The normals only where a planar constraint reads them (the others keep what
+        // they hold, never read).
+        if let (true, Some(axis)) = (parent != NONE, rig.planar_axis(p)) {
             let pj = rig.joint[parent as usize] as usize;
-            normals[p] = models[pj].rotation * rig.planar_local_axis(p);
+            normals[p] = models[pj].rotation * axis;
         }
     }
     place_colliders(rig, models, colliders);
