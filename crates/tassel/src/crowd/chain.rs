@@ -1489,14 +1489,28 @@ impl Ctx<'_> {
             let same = |l: usize, last: Option<usize>| {
                 last.filter(|&k| pack.shared && w.0[k].to_bits() == w.0[l].to_bits())
             };
+            // Every active lane's step ends with the frame (the usual case): the frame's
+            // own placement (`PlacedCollider::lerp` from 1 on) and bound, copied whole into
+            // every lane, each lane's entry then saying so.
+            let all_end = (0..LANES).all(|l| active.0[l] == 0 || w.0[l] >= 1.0);
             for &c in &chain.colliders {
+                if all_end {
+                    let placed = |l: usize| s.step_placed_at[l * k_all + c].to_bits();
+                    if (0..LANES).any(|l| active.0[l] != 0 && placed(l) != 1f32.to_bits()) {
+                        for l in 0..LANES {
+                            let at = l * k_all + c;
+                            s.step_colliders[at] = s.colliders[at];
+                            s.step_placed_at[at] = 1.0;
+                        }
+                        s.step_bounds[c] = s.bounds[c];
+                    }
+                    continue;
+                }
                 let mut last = None;
                 for l in 0..LANES {
                     let at = l * k_all + c;
                     if active.0[l] != 0 && s.step_placed_at[at].to_bits() != w.0[l].to_bits() {
                         if w.0[l] >= 1.0 {
-                            // The frame's own placement (`PlacedCollider::lerp` from 1 on),
-                            // and so its bound.
                             s.step_colliders[at] = s.colliders[at];
                             s.step_bounds[c].set_lane_from(l, &s.bounds[c]);
                             s.step_placed_at[at] = w.0[l];
