@@ -112,7 +112,10 @@ impl CharacterSim {
         }
         // Checked here, once, before any solver state is touched: a bad frame is an error
         // and the next good frame carries on from where the last good one left off.
-        if let Some(j) = animated.iter().position(|t| !t.within_limits()) {
+        // One pass without a branch per joint; the joint named only when one fails.
+        let all_within = animated.iter().fold(true, |ok, t| ok & t.within_limits());
+        let first_bad = || animated.iter().position(|t| !t.within_limits());
+        if let Some(j) = (!all_within).then(first_bad).flatten() {
             return Err(Error::NonFinite(format!(
                 "animated pose of joint '{}' is not finite, not a unit rotation, or lies \
                  beyond {:e}",

@@ -157,6 +157,28 @@ impl core::ops::Mul for Transform {
     }
 }
 
+/// Whether every transform of `ts` is finite ([`Transform::is_finite`] for all): one pass
+/// that ORs a flag per component (an exponent of all ones: infinity or NaN), without a
+/// branch per transform, for the solvers' checks of a whole pose.
+pub(crate) fn all_finite(ts: &[Transform]) -> bool {
+    const EXP: u32 = 0x7f80_0000;
+    let bad = |x: f32| u32::from(x.to_bits() & EXP == EXP);
+    let any_bad = ts.iter().fold(0, |acc, t| {
+        let (v, q, s) = (t.translation, t.rotation, t.scale);
+        acc | bad(v.x)
+            | bad(v.y)
+            | bad(v.z)
+            | bad(q.x)
+            | bad(q.y)
+            | bad(q.z)
+            | bad(q.w)
+            | bad(s.x)
+            | bad(s.y)
+            | bad(s.z)
+    });
+    any_bad == 0
+}
+
 /// Slerp that always takes the shorter way round (flips `b` into `a`'s hemisphere).
 pub fn slerp_shortest(a: Quat, b: Quat, t: f32) -> Quat {
     let b = if a.dot(b) < 0.0 { -b } else { b };
@@ -299,6 +321,43 @@ pub fn closest_point_on_triangle(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> Vec3 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// `all_finite` says what `is_finite` on every transform says: for poses of finite
+    /// values (the largest and smallest floats among them) and for each component of each
+    /// transform in turn made +∞, −∞ or NaN.
+    #[test]
+    fn all_finite_is_every_transform_finite() {
+        let pose: Vec<Transform> = (0..5)
+            .map(|i| Transform {
+                translation: Vec3::new(f32::MAX, -f32::MAX, i as f32),
+                rotation: Quat::from_xyzw(f32::MIN_POSITIVE, 0.0, -0.0, 1.0),
+                scale: Vec3::new(1e-45, 1.0, 3e38),
+            })
+            .collect();
+        assert!(all_finite(&pose) && pose.iter().all(Transform::is_finite));
+        assert!(all_finite(&[]));
+        let mut bad_cases = 0;
+        for j in 0..pose.len() {
+            for c in 0..10 {
+                for v in [f32::INFINITY, f32::NEG_INFINITY, f32::NAN] {
+                    let mut p = pose.clone();
+                    let t = &mut p[j];
+                    match c {
+                        0..=2 => t.translation[c] = v,
+                        3 => t.rotation.x = v,
+                        4 => t.rotation.y = v,
+                        5 => t.rotation.z = v,
+                        6 => t.rotation.w = v,
+                        _ => t.scale[c - 7] = v,
+                    }
+                    assert!(!p.iter().all(Transform::is_finite));
+                    assert!(!all_finite(&p), "joint {j} component {c} value {v}");
+                    bad_cases += 1;
+                }
+            }
+        }
+        assert_eq!(bad_cases, 5 * 10 * 3);
+    }
 
     /// Small angles by hand: X turned by θ about Z is (0, 0, sin θ/2, cos θ/2), down to
     /// angles far below the old 1 − 1e-7 dead zone (≈ 4.5e-4 rad).

@@ -251,7 +251,11 @@ impl ChainJob<'_> {
         if !self.component.is_finite() {
             return Err(Error::NonFinite("character transform".into()));
         }
-        if let Some(i) = self.models.iter().position(|m| !m.is_finite()) {
+        let first_bad = || self.models.iter().position(|m| !m.is_finite());
+        if let Some(i) = (!crate::math::all_finite(self.models))
+            .then(first_bad)
+            .flatten()
+        {
             return Err(Error::NonFinite(format!(
                 "animated pose of joint '{}'",
                 self.skeleton.name(i)
