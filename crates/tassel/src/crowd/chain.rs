@@ -1603,6 +1603,19 @@ impl Ctx<'_> {
 mod tests {
     use super::*;
 
+    /// Lane `l` of a motion, as bits.
+    #[allow(clippy::type_complexity)]
+    fn motion_bits(m: &Motion, l: usize) -> ([u32; 3], [u32; 4], [u32; 3], [u32; 3], u32) {
+        let v = |v: Vec3| v.to_array().map(f32::to_bits);
+        (
+            v(m.move_cs.get(l)),
+            m.rotate_cs.get(l).to_array().map(f32::to_bits),
+            v(m.gravity_step.get(l)),
+            v(m.wind_cs.get(l)),
+            m.wind_on.0[l],
+        )
+    }
+
     /// The memo answers as [`motion`] computed afresh, bit for bit, in the lanes asked,
     /// over calls that repeat or change each of its inputs (settings, time, mode, either
     /// transform in one lane, the lanes asked); and it is used (calls it answers itself,
@@ -1623,16 +1636,6 @@ mod tests {
         let mut to = Trs::splat(&transform(&mut u));
         let (mut dt, mut fixed, mut has_from) = (1.0 / 60.0, true, true);
         let mut active = M::ALL;
-        let bits = |m: &Motion, l: usize| {
-            let v = |v: Vec3| v.to_array().map(f32::to_bits);
-            (
-                v(m.move_cs.get(l)),
-                m.rotate_cs.get(l).to_array().map(f32::to_bits),
-                v(m.gravity_step.get(l)),
-                v(m.wind_cs.get(l)),
-                m.wind_on.0[l],
-            )
-        };
         for round in 0..4000 {
             let l = (u(0.0, 8.0) as usize).min(LANES - 1);
             match round % 11 {
@@ -1666,7 +1669,11 @@ mod tests {
                 let want = motion(&settings, f, &to, dt, fixed, active, false);
                 for l in 0..LANES {
                     if active.0[l] != 0 {
-                        assert_eq!(bits(&got, l), bits(&want, l), "round {round} lane {l}");
+                        assert_eq!(
+                            motion_bits(&got, l),
+                            motion_bits(&want, l),
+                            "round {round} lane {l}"
+                        );
                     }
                 }
             }
@@ -1685,16 +1692,6 @@ mod tests {
         let mut settings = ChainSettings::default();
         settings.wind.speed = 0.5;
         settings.wind.direction = Vec3::X;
-        let bits = |m: &Motion, l: usize| {
-            let v = |v: Vec3| v.to_array().map(f32::to_bits);
-            (
-                v(m.move_cs.get(l)),
-                m.rotate_cs.get(l).to_array().map(f32::to_bits),
-                v(m.gravity_step.get(l)),
-                v(m.wind_cs.get(l)),
-                m.wind_on.0[l],
-            )
-        };
         let (mut all_same, mut one_differs) = (0, 0);
         for round in 0..3000 {
             let mut t = || {
@@ -1743,7 +1740,11 @@ mod tests {
             let got = motion(&settings, f, &to, 1.0 / 60.0, true, active, true);
             let want = motion(&settings, f, &to, 1.0 / 60.0, true, active, false);
             for k in 0..LANES {
-                assert_eq!(bits(&got, k), bits(&want, k), "round {round} lane {k}");
+                assert_eq!(
+                    motion_bits(&got, k),
+                    motion_bits(&want, k),
+                    "round {round} lane {k}"
+                );
             }
         }
         assert!(
