@@ -117,32 +117,58 @@ impl LaneShape {
 /// narrow phase's own operations: which lanes it may move (the others get their point
 /// back unchanged), which of those the step *entered* (the swept contact, answered by
 /// [`super::entry_lanes`]: rarer, and with a root finding of its own), and for the lanes it
-/// may move without an entry, the point it gives back (pushed out to the surface); and
-/// what the swept entry computes again ([`super::entry_lanes`] takes it from here).
+/// may move without an entry, the point it gives back (pushed out to the surface,
+/// [`LaneContact::pushed`]); and what the swept entry computes again
+/// ([`super::entry_lanes`] takes it from here). The push and its fallback direction are
+/// kept as their operands and computed only when asked: most contacts move no lane.
 #[derive(Clone, Copy)]
 pub(super) struct LaneContact<T: Lane> {
     pub may: T::M,
     pub entered: T::M,
-    pub pushed: V3<T>,
-    /// The push's fallback direction, from the step's start.
-    pub fallback: V3<T>,
     /// A capsule's: the share of the step at its closest approach to the axis, and the
     /// step's start's distance from the axis (a sphere's: 0).
     pub along: T,
     pub prev_dist: T,
+    /// The push `base + d.normalize_or(fallback) * limit` ...
+    base: V3<T>,
+    d: V3<T>,
+    limit: T,
+    /// ... with the fallback direction `fb_from.normalize_or(alt)`, `alt` a direction
+    /// across the capsule's axis `fb_axis` (its `any_orthonormal`), or Y for a sphere.
+    fb_from: V3<T>,
+    fb_axis: Option<V3<T>>,
 }
 
 impl<T: Lane> LaneContact<T> {
+    /// The push's fallback direction (from the step's start where it stepped).
+    #[inline(always)]
+    pub(super) fn fallback(&self) -> V3<T> {
+        let alt = match self.fb_axis {
+            Some(axis) => axis.any_orthonormal(),
+            None => V3::splat(Vec3::Y),
+        };
+        self.fb_from.normalize_or(alt)
+    }
+
+    /// The point pushed out to the surface (for the lanes it may move without an entry).
+    #[inline(always)]
+    pub(super) fn pushed(&self) -> V3<T> {
+        self.base + self.d.normalize_or(self.fallback()) * self.limit
+    }
+
     /// In the portable lane type (the same lanes).
     #[inline(always)]
     pub(super) fn f(&self) -> LaneContact<F> {
         LaneContact {
             may: self.may.m(),
             entered: self.entered.m(),
-            pushed: self.pushed.f(),
-            fallback: self.fallback.f(),
             along: self.along.f(),
             prev_dist: self.prev_dist.f(),
+            base: self.base.f(),
+            d: self.d.f(),
+            limit: self.limit.f(),
+            fb_from: self.fb_from.f(),
+            fb_axis: self.fb_axis.map(|v| v.f()),
         }
     }
 
@@ -152,10 +178,13 @@ impl<T: Lane> LaneContact<T> {
         LaneContact {
             may: <T::M as Mask>::of(c.may),
             entered: <T::M as Mask>::of(c.entered),
-            pushed: V3::of(c.pushed),
-            fallback: V3::of(c.fallback),
             along: T::of(c.along),
             prev_dist: T::of(c.prev_dist),
+            base: V3::of(c.base),
+            d: V3::of(c.d),
+            limit: T::of(c.limit),
+            fb_from: V3::of(c.fb_from),
+            fb_axis: c.fb_axis.map(V3::of),
         }
     }
 }
@@ -179,14 +208,16 @@ pub(super) fn sphere_contact<T: Lane>(
     let entered = prev_out.and(c.dot(c).lt(inner2));
     let d = p - center;
     // `outside_sphere(p, center, limit, normalize_or(prev - center, Y))` where it pushes.
-    let fallback = from.normalize_or(V3::splat(Vec3::Y));
     LaneContact {
         may: entered.or(d.dot(d).lt(limit * limit)),
         entered,
-        pushed: center + d.normalize_or(fallback) * limit,
-        fallback,
         along: T::splat(0.0),
         prev_dist: T::splat(0.0),
+        base: center,
+        d,
+        limit,
+        fb_from: from,
+        fb_axis: None,
     }
 }
 
@@ -196,14 +227,16 @@ pub(super) fn sphere_contact<T: Lane>(
 #[inline(always)]
 pub(super) fn sphere_contact_still<T: Lane>(p: V3<T>, center: V3<T>, limit: T) -> LaneContact<T> {
     let d = p - center;
-    let fallback = d.normalize_or(V3::splat(Vec3::Y));
     LaneContact {
         may: d.dot(d).lt(limit * limit),
         entered: <T::M as Mask>::NONE,
-        pushed: center + d.normalize_or(fallback) * limit,
-        fallback,
         along: T::splat(0.0),
         prev_dist: T::splat(0.0),
+        base: center,
+        d,
+        limit,
+        fb_from: d,
+        fb_axis: None,
     }
 }
 
@@ -228,14 +261,16 @@ pub(super) fn capsule_contact_still<T: Lane>(
     let d = p - c;
     let (dist2, dist) = (d.dot(d), d.length());
     let entered = inner.le(dist).and(dist2.lt(inner * inner));
-    let fallback = d.normalize_or(ab.any_orthonormal());
     LaneContact {
         may: entered.or(dist2.lt(limit * limit)),
         entered,
-        pushed: c + d.normalize_or(fallback) * limit,
-        fallback,
         along: T::splat(0.0),
         prev_dist: dist,
+        base: c,
+        d,
+        limit,
+        fb_from: d,
+        fb_axis: Some(ab),
     }
 }
 
@@ -275,14 +310,16 @@ pub(super) fn capsule_contact<T: Lane>(
         (T::splat(0.0), <T::M as Mask>::NONE)
     };
     // `outside_capsule(p, a, b, limit, prev_fallback())` where it pushes.
-    let fallback = from_axis.normalize_or((b - a).any_orthonormal());
     LaneContact {
         may: entered.or(d.dot(d).lt(limit * limit)),
         entered,
-        pushed: c + d.normalize_or(fallback) * limit,
-        fallback,
         along: s,
         prev_dist,
+        base: c,
+        d,
+        limit,
+        fb_from: from_axis,
+        fb_axis: Some(b - a),
     }
 }
 
@@ -486,7 +523,7 @@ fn collide<T: Lane>(
             ask = ask.and(contact.may);
             let pushed = ask.and(contact.entered.not());
             if pushed.any() {
-                y = V3::select(pushed, contact.pushed, y);
+                y = V3::select(pushed, contact.pushed(), y);
                 moved = pushed.and(differs(y, x)).or(pushed.not().and(moved));
             }
             ask = ask.and(contact.entered);
@@ -813,10 +850,10 @@ mod tests {
             };
             assert_eq!(m(still.may), m(step.may), "round {round}: may");
             assert_eq!(m(still.entered), m(step.entered), "round {round}: entered");
-            assert_eq!(v(still.pushed), v(step.pushed), "round {round}: pushed");
+            assert_eq!(v(still.pushed()), v(step.pushed()), "round {round}: pushed");
             assert_eq!(
-                v(still.fallback),
-                v(step.fallback),
+                v(still.fallback()),
+                v(step.fallback()),
                 "round {round}: fallback"
             );
             if capsule {
@@ -988,7 +1025,7 @@ mod tests {
             } else {
                 sphere_contact(p, q, c, F::splat(limit))
             };
-            let (may, entered, pushed) = (contact.may, contact.entered, contact.pushed);
+            let (may, entered, pushed) = (contact.may, contact.entered, contact.pushed());
             let (entry, hard) = if capsule {
                 capsule_entry_push(p, q, a, b, F::splat(limit), &contact)
             } else {
@@ -1084,6 +1121,12 @@ mod tests {
             let k = sphere_contact(p, q, c, limit);
             (k, (sphere_entry(p, q, c, limit, &k), <Fa as Lane>::M::NONE))
         };
-        (k.may.m(), k.entered.m(), k.pushed.f(), entry.f(), hard.m())
+        (
+            k.may.m(),
+            k.entered.m(),
+            k.pushed().f(),
+            entry.f(),
+            hard.m(),
+        )
     }
 }

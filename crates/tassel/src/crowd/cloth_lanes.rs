@@ -323,7 +323,7 @@ impl Pass<'_> {
                         None => sphere_contact(y, from, centre, limit),
                     };
                     ask = ask.and(c.may);
-                    after = V3::select(ask.and(c.entered.not()), c.pushed, after);
+                    after = V3::select(ask.and(c.entered.not()), c.pushed(), after);
                     ask = ask.and(c.entered);
                 }
                 // The scalar collider for what the lanes leave: entries, other shapes.

@@ -261,7 +261,7 @@ pub(super) fn sphere_entry<T: Lane>(
     let t = T::select(vv.gt(zero), ((-ov - disc.sqrt()) / vv).clamp01(), zero);
     let at = prev + v * t;
     // The fallback `(prev - center).normalize_or(Y)`, as the contact computed it.
-    let n = (at - center).normalize_or(contact.fallback);
+    let n = (at - center).normalize_or(contact.fallback());
     let slid = slide(at, p, n);
     outside_sphere(slid, center, limit, n)
 }
@@ -300,7 +300,7 @@ pub(super) fn capsule_entry_push<T: Lane>(
     contact: &LaneContact<T>,
 ) -> (V3<T>, T::M) {
     let inner = entry_radius_lanes(limit);
-    let (prev_dist, prev_fallback, s) = (contact.prev_dist, contact.fallback, contact.along);
+    let (prev_dist, prev_fallback, s) = (contact.prev_dist, contact.fallback(), contact.along);
     let (t, found) = capsule_entry(prev.f(), (p - prev).f(), a.f(), b.f(), inner.f());
     let beyond = inner.lt(prev_dist);
     let lo = T::select(beyond, min_f(T::of(t), s), T::splat(0.0));
