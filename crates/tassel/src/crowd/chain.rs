@@ -663,19 +663,20 @@ impl Twins {
         let (pack, s) = (&mut self.pack, &mut self.scratch);
         let n = pack.pos.len();
         let m = colliders.len();
+        // The normals only where a planar constraint reads them (`rig` is one chain).
+        let planar = rig.planar_axis(0).is_some();
         for (l, start) in starts.clone().enumerate() {
             for k in 0..n {
                 s.targets[k].set(l, targets[start + k]);
-                s.normals[k].set(l, normals[start + k]);
+                if planar {
+                    s.normals[k].set(l, normals[start + k]);
+                }
             }
             s.colliders[l * m..(l + 1) * m].copy_from_slice(colliders);
         }
         // The same colliders in every lane: each bound computed once.
         for (b, c) in s.bounds.iter_mut().zip(colliders) {
-            b.set(0, c);
-            for l in 1..pack.count {
-                b.copy_lane(0, l);
-            }
+            *b = Bound::splat(c);
         }
         s.component = Trs::splat(&frame.component);
         Ctx {

@@ -61,15 +61,33 @@ impl Bound {
     /// Lane `l` from its placed collider.
     #[inline]
     pub(super) fn set(&mut self, l: usize, c: &PlacedCollider) {
-        let s = c.bound_sphere();
+        let (s, a, b) = Bound::parts(c);
         self.c.set(l, s.truncate());
         self.w.0[l] = s.w;
+        self.a.set(l, a);
+        self.b.set(l, b);
+    }
+
+    /// Every lane from one placed collider.
+    #[inline]
+    pub(super) fn splat(c: &PlacedCollider) -> Bound {
+        let (s, a, b) = Bound::parts(c);
+        Bound {
+            c: V3::splat(s.truncate()),
+            w: F::splat(s.w),
+            a: V3::splat(a),
+            b: V3::splat(b),
+        }
+    }
+
+    /// A collider's bounding sphere and axis ends (a capsule's; other shapes: the centre).
+    #[inline]
+    fn parts(c: &PlacedCollider) -> (glam::Vec4, Vec3, Vec3) {
         let (a, b) = match c.shape {
             Shape::Capsule { length, .. } => c.capsule_ends(length),
             _ => (c.transform.translation, c.transform.translation),
         };
-        self.a.set(l, a);
-        self.b.set(l, b);
+        (c.bound_sphere(), a, b)
     }
 }
 
