@@ -863,7 +863,9 @@ fn motion(
     // for bit) as the first: that lane's motion is every lane's (the same function of
     // the same values).
     if let Some(k) = (0..LANES).find(|&l| active.0[l] != 0).filter(|&k| {
-        shared && lanes_as(to, k, active) && from.is_none_or(|a| lanes_as(a, k, active))
+        // `same_lanes` against lane `k` in every lane.
+        let as_k = |a: &Trs| same_lanes(a, &Trs::splat(&a.get(k)), active);
+        shared && as_k(to) && from.is_none_or(as_k)
     }) {
         let b = to.get(k);
         let (m, r) = match from {
@@ -873,7 +875,7 @@ fn motion(
         let g = gravity_step(s, gravity_cs(s, &b), dt, fixed);
         let w = wind_cs(s, &b);
         let on = s.wind.speed > 0.0 && w != Vec3::ZERO;
-        let pick = |v: Vec3, zero: &V3| V3::select(active, V3::splat(v), *zero);
+        let pick = |v: Vec3, rest: &V3| V3::select(active, V3::splat(v), *rest);
         out.move_cs = pick(m, &out.move_cs);
         out.rotate_cs = Q::select(active, Q::splat(r), out.rotate_cs);
         out.gravity_step = pick(g, &out.gravity_step);
@@ -916,17 +918,6 @@ fn motion(
     }
     out.wind_on = M::from_bools(wind);
     out
-}
-
-/// Whether every lane of `m` in `a` holds lane `k`'s bits.
-#[inline]
-fn lanes_as(a: &Trs, k: usize, m: M) -> bool {
-    // As `same_lanes`, against lane `k` in every lane.
-    let differ = |x: &F| {
-        let at_k = x.0[k].to_bits();
-        (0..LANES).fold(0, |d, l| d | ((x.0[l].to_bits() ^ at_k) & m.0[l]))
-    };
-    fields(a).iter().fold(0, |d, x| d | differ(x)) == 0
 }
 
 /// Whether two transforms are the same bits.
