@@ -246,6 +246,8 @@ impl Scratch {
         let m = rig.colliders.len();
         let zero = V3::splat(Vec3::ZERO);
         Scratch {
+    /// The write-back's new model rotation per rotator, and the lanes it leaves animated.
+    new_rotations: Vec<(Q, M)>,
             models: vec![Transform::IDENTITY; joints * LANES],
             lane_models: vec![Trs::splat(&Transform::IDENTITY); joints],
             lane_local_rotations: vec![Q::splat(Quat::IDENTITY); joints],
@@ -274,6 +276,7 @@ impl Scratch {
         }
     }
 }
+            new_rotations: vec![(Q::splat(Quat::IDENTITY), M::NONE); rig.rotators.len()],
 
 /// Many characters with the same bone chains, advanced together.
 ///
@@ -1218,7 +1221,11 @@ impl Ctx<'_> {
         }
         let zero = V3::splat(Vec3::ZERO);
         let tiny = F::splat(1e-12);
-        for (k, (joint, point, kids)) in rig.rotators.iter().enumerate() {
+        // Two passes: first every rotator's new model rotation (each reads only its own
+        // joint's animated one, so the processor overlaps the rotators' long chains of
+        // roots and divisions), then every local rotation, which reads its parent's new
+        // model rotation. The same operations on the same values.
+        for ((joint, point, kids), turn) in rig.rotators.iter().zip(&mut s.new_rotations) {
             let (j, p) = (*joint as usize, *point as usize);
             let (mut anim, mut sim) = (zero, zero);
             for &c in &rig.rotator_children[kids.start as usize..kids.end as usize] {
@@ -1245,6 +1252,11 @@ impl Ctx<'_> {
         let set = &rig.chains[ci].settings;
         let points = rig.chains[ci].points.clone();
         // Teleport detection on each character's own motion this frame.
+            *turn = (new_rot, skip);
+        }
+        for (k, (joint, _, _)) in rig.rotators.iter().enumerate() {
+            let j = *joint as usize;
+            let (new_rot, skip) = s.new_rotations[k];
         for l in 0..pack.count {
             if pack.needs_reset[ci][l] {
                 continue;

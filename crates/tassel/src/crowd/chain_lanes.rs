@@ -15,7 +15,7 @@
 pub(crate) use super::chain::LaneFrame;
 use super::chain::Twins;
 use super::chain_step::LaneShape;
-use super::lanes::{rotation_arc, Lane, Mask, F, LANES, Q, V3};
+use super::lanes::{rotation_arc, Lane, Mask, F, LANES, M, Q, V3};
 use crate::collide::PlacedCollider;
 use crate::dynamics::chain::compile::{ChainRig, CompiledChain, NONE};
 use crate::dynamics::path::CharacterPath;
@@ -57,6 +57,18 @@ pub(crate) struct LaneRotator {
     kids: Vec<usize>,
     /// Whose model rotation its local rotation is relative to.
     parent: RotatorParent,
+}
+
+/// One rotator row of the lanes' write-back between its two passes.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct TurnedRow {
+    /// The row's new model rotation (where not `skip`).
+    new_rot: Q,
+    /// What the row's children see as their parent's model rotation: the new one, or the
+    /// animated one where the row is skipped.
+    turned: Q,
+    /// The lanes left as animated (no direction to turn from or toward).
+    skip: M,
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -345,7 +357,7 @@ impl ChainLanes {
         group: &ChainLaneGroup,
         locals: &mut [Transform],
         models: &mut [Transform],
-        turned: &mut Vec<Q>,
+        turned: &mut Vec<TurnedRow>,
         avx2: bool,
     ) {
         let Some(rotators) = &group.write_back else {
@@ -371,7 +383,7 @@ impl ChainLanes {
         rotators: &[LaneRotator],
         locals: &mut [Transform],
         models: &mut [Transform],
-        turned: &mut Vec<Q>,
+        turned: &mut Vec<TurnedRow>,
     ) {
         // The explicit AVX lane type, only here after the CPU was found to have AVX2.
         self.write_back_lanes::<super::avx::Fa>(group, rotators, locals, models, turned)
@@ -385,15 +397,18 @@ impl ChainLanes {
         rotators: &[LaneRotator],
         locals: &mut [Transform],
         models: &mut [Transform],
-        turned: &mut Vec<Q>,
+        turned: &mut Vec<TurnedRow>,
     ) {
         let count = group.chains.len();
         // This frame's targets and output points, already in lanes.
         let (targets, out) = self.twins.targets_and_out();
         let zero = V3::<T>::splat(Vec3::ZERO);
         let tiny = T::splat(1e-12);
+        // Two passes: first every row's new model rotation (the rows are independent, so
+        // the processor overlaps their long chains of roots and divisions), then every
+        // row's local rotation, which reads its parent row's. The same operations.
         turned.clear();
-        for (k, r) in rotators.iter().enumerate() {
+        for r in rotators {
             let (ta, oa) = (V3::<T>::of(targets[r.point]), V3::<T>::of(out[r.point]));
             let (mut anim, mut sim) = (zero, zero);
             for &c in &r.kids {
@@ -407,9 +422,17 @@ impl ChainLanes {
             }
             let new_rot = rotation_arc(anim, sim)
                 .mul_quat(Q::<T>::of(animated))
-                .normalize();
+                .normalize()
+                .f();
+            turned.push(TurnedRow {
+                new_rot,
+                turned: Q::select(skip, animated, new_rot),
+                skip,
+            });
+        }
+        for (r, row) in rotators.iter().zip(turned.iter()) {
             let parent_rot = match r.parent {
-                RotatorParent::Rotator(k2) => turned[k2],
+                RotatorParent::Rotator(k2) => turned[k2].turned,
                 RotatorParent::Joint(q) => {
                     let mut p = Q::splat(Quat::IDENTITY);
                     for (l, &j) in q.iter().enumerate().take(count) {
@@ -421,18 +444,15 @@ impl ChainLanes {
             };
             let local = Q::<T>::of(parent_rot)
                 .conjugate()
-                .mul_quat(new_rot)
+                .mul_quat(Q::<T>::of(row.new_rot))
                 .normalize()
                 .f();
-            let new_rot = new_rot.f();
             for (l, &j) in r.joints.iter().enumerate().take(count) {
-                if skip.0[l] == 0 {
+                if row.skip.0[l] == 0 {
                     locals[j as usize].rotation = local.get(l);
-                    models[j as usize].rotation = new_rot.get(l);
+                    models[j as usize].rotation = row.new_rot.get(l);
                 }
             }
-            turned.push(Q::select(skip, animated, new_rot));
-            debug_assert_eq!(turned.len(), k + 1);
         }
     }
 

@@ -58,7 +58,7 @@ pub struct ChainState {
     lanes: Vec<ChainLanes>,
     in_lanes: bool,
     /// Scratch of the lanes' write-back: each rotator's new model rotation.
-    turned: Vec<crate::crowd::lanes::Q>,
+    turned: Vec<crate::crowd::chain_lanes::TurnedRow>,
 }
 
 impl ChainState {
