@@ -44,7 +44,8 @@ struct Pack {
     out: Vec<V3>,
     prev_targets: Vec<V3>,
     prev_normals: Vec<V3>,
-    /// Last frame's placed colliders, lane after lane (`m` per lane).
+    /// Last frame's placed colliders, lane after lane (`m` per lane; `shared`: the first
+    /// lane's only, [`Pack::collider_stride`]).
     prev_colliders: Vec<PlacedCollider>,
     // Per chain.
     last_step_component: Vec<Trs>,
@@ -62,11 +63,22 @@ struct Pack {
     error: Option<(usize, Error)>,
     /// Every lane is the same character (twin chains of one character: one path, one
     /// transform, the same colliders): a lane's place on the path, placed colliders and
-    /// motion are copied from an earlier lane that asked the same, not computed again.
+    /// motion are copied from an earlier lane that asked the same, not computed again;
+    /// the frame's placed colliders are kept once, in the first lane's place.
     shared: bool,
 }
 
 impl Pack {
+    /// Where lane `l`'s placed colliders start in `prev_colliders` and in the scratch's
+    /// `colliders`, over `l`: `m`, or 0 where every lane has the same (`shared`).
+    fn collider_stride(&self) -> usize {
+        if self.shared {
+            0
+        } else {
+            self.prev_colliders.len() / LANES
+        }
+    }
+
     fn new(rig: &ChainRig) -> Pack {
         let n = rig.point_count();
         let m = rig.colliders.len();
@@ -234,6 +246,8 @@ struct Scratch {
     path_at: Trs,
     /// The write-back's model rotations per joint (the rotator joints and their parents).
     rotations: Vec<Q>,
+    /// The write-back's new model rotation per rotator, and the lanes it leaves animated.
+    new_rotations: Vec<(Q, M)>,
     /// A point's broad phase: the lanes each member of its chain's collider list may touch.
     near: Vec<M>,
     /// The last motion computed.
@@ -246,8 +260,6 @@ impl Scratch {
         let m = rig.colliders.len();
         let zero = V3::splat(Vec3::ZERO);
         Scratch {
-    /// The write-back's new model rotation per rotator, and the lanes it leaves animated.
-    new_rotations: Vec<(Q, M)>,
             models: vec![Transform::IDENTITY; joints * LANES],
             lane_models: vec![Trs::splat(&Transform::IDENTITY); joints],
             lane_local_rotations: vec![Q::splat(Quat::IDENTITY); joints],
@@ -264,6 +276,7 @@ impl Scratch {
             path_w: [f32::NAN; LANES],
             path_at: Trs::splat(&Transform::IDENTITY),
             rotations: vec![Q::splat(Quat::IDENTITY); joints],
+            new_rotations: vec![(Q::splat(Quat::IDENTITY), M::NONE); rig.rotators.len()],
             near: vec![
                 M::ALL;
                 rig.chains
@@ -276,7 +289,6 @@ impl Scratch {
         }
     }
 }
-            new_rotations: vec![(Q::splat(Quat::IDENTITY), M::NONE); rig.rotators.len()],
 
 /// Many characters with the same bone chains, advanced together.
 ///
@@ -592,8 +604,8 @@ impl Twins {
             p.prev_targets[k].set(l, s.prev_targets[q]);
             p.prev_normals[k].set(l, s.prev_normals[q]);
         }
-        let m = p.prev_colliders.len() / LANES;
-        p.prev_colliders[l * m..(l + 1) * m].copy_from_slice(s.prev_colliders);
+        let (m, at) = (s.prev_colliders.len(), l * p.collider_stride());
+        p.prev_colliders[at..at + m].copy_from_slice(s.prev_colliders);
         p.last_step_component[0].set(l, &s.last_step_component[ci]);
         p.accumulator[0].0[l] = s.accumulator[ci];
         p.dt_old[0].0[l] = s.dt_old[ci];
@@ -675,8 +687,9 @@ impl Twins {
                     s.normals[k].set(l, normals[start + k]);
                 }
             }
-            s.colliders[l * m..(l + 1) * m].copy_from_slice(colliders);
         }
+        // The same colliders in every lane: kept once (`Pack::collider_stride`).
+        s.colliders[..m].copy_from_slice(colliders);
         // The same colliders in every lane: each bound computed once.
         for (b, c) in s.bounds.iter_mut().zip(colliders) {
             *b = Bound::splat(c);
@@ -1201,7 +1214,11 @@ impl Ctx<'_> {
         }
         pack.prev_targets.copy_from_slice(&s.targets);
         pack.prev_normals.copy_from_slice(&s.normals);
-        pack.prev_colliders.copy_from_slice(&s.colliders);
+        let kept = match pack.shared {
+            true => pack.prev_colliders.len() / LANES,
+            false => pack.prev_colliders.len(),
+        };
+        pack.prev_colliders[..kept].copy_from_slice(&s.colliders[..kept]);
         pack.prev_component = s.component;
     }
 
@@ -1235,6 +1252,11 @@ impl Ctx<'_> {
             }
             let skip = anim.dot(anim).lt(tiny).or(sim.dot(sim).lt(tiny));
             let new_rot = rotation_arc(anim, sim).mul_quat(s.rotations[j]).normalize();
+            *turn = (new_rot, skip);
+        }
+        for (k, (joint, _, _)) in rig.rotators.iter().enumerate() {
+            let j = *joint as usize;
+            let (new_rot, skip) = s.new_rotations[k];
             let parent_rot = match sk.parent(j) {
                 Some(q) => s.rotations[q],
                 None => Q::splat(Quat::IDENTITY),
@@ -1252,11 +1274,6 @@ impl Ctx<'_> {
         let set = &rig.chains[ci].settings;
         let points = rig.chains[ci].points.clone();
         // Teleport detection on each character's own motion this frame.
-            *turn = (new_rot, skip);
-        }
-        for (k, (joint, _, _)) in rig.rotators.iter().enumerate() {
-            let j = *joint as usize;
-            let (new_rot, skip) = s.new_rotations[k];
         for l in 0..pack.count {
             if pack.needs_reset[ci][l] {
                 continue;
@@ -1310,6 +1327,7 @@ impl Ctx<'_> {
             &pack.dev_before,
             &pack.dev,
             &s.colliders,
+            pack.collider_stride(),
             &s.bounds,
             self.shapes,
             &mut pack.out,
@@ -1356,6 +1374,7 @@ impl Ctx<'_> {
                     targets: &s.targets,
                     normals: &s.normals,
                     colliders: &s.colliders,
+                    stride: pack.collider_stride(),
                     bounds: &s.bounds,
                     shapes: self.shapes,
                     move_cs: mo.move_cs,
@@ -1410,6 +1429,7 @@ impl Ctx<'_> {
                 targets: &s.targets,
                 normals: &s.normals,
                 colliders: &s.colliders,
+                stride: pack.collider_stride(),
                 bounds: &s.bounds,
                 shapes: self.shapes,
                 move_cs: mo.move_cs,
@@ -1493,29 +1513,23 @@ impl Ctx<'_> {
             let same = |l: usize, last: Option<usize>| {
                 last.filter(|&k| pack.shared && w.0[k].to_bits() == w.0[l].to_bits())
             };
-            // Every active lane's step ends with the frame (the usual case): the frame's
-            // own placement (`PlacedCollider::lerp` from 1 on) and bound, copied whole into
-            // every lane, each lane's entry then saying so.
+            // Where every active lane's step ends with the frame (the usual case), the step
+            // reads the frame's own placement (`PlacedCollider::lerp` from 1 on) and bounds
+            // as they are; else each lane's placement at its share of the frame.
             let all_end = (0..LANES).all(|l| active.0[l] == 0 || w.0[l] >= 1.0);
-            for &c in &chain.colliders {
-                if all_end {
-                    let placed = |l: usize| s.step_placed_at[l * k_all + c].to_bits();
-                    if (0..LANES).any(|l| active.0[l] != 0 && placed(l) != 1f32.to_bits()) {
-                        for l in 0..LANES {
-                            let at = l * k_all + c;
-                            s.step_colliders[at] = s.colliders[at];
-                            s.step_placed_at[at] = 1.0;
-                        }
-                        s.step_bounds[c] = s.bounds[c];
-                    }
-                    continue;
-                }
+            let stride = pack.collider_stride();
+            let placed_per_lane = if all_end {
+                &[][..]
+            } else {
+                &chain.colliders[..]
+            };
+            for &c in placed_per_lane {
                 let mut last = None;
                 for l in 0..LANES {
-                    let at = l * k_all + c;
+                    let (at, frame_at) = (l * k_all + c, l * stride + c);
                     if active.0[l] != 0 && s.step_placed_at[at].to_bits() != w.0[l].to_bits() {
                         if w.0[l] >= 1.0 {
-                            s.step_colliders[at] = s.colliders[at];
+                            s.step_colliders[at] = s.colliders[frame_at];
                             s.step_bounds[c].set_lane_from(l, &s.bounds[c]);
                             s.step_placed_at[at] = w.0[l];
                             continue;
@@ -1526,8 +1540,8 @@ impl Ctx<'_> {
                                 s.step_bounds[c].copy_lane(k, l);
                             }
                             None => {
-                                s.step_colliders[at] =
-                                    pack.prev_colliders[at].lerp(&s.colliders[at], w.0[l]);
+                                s.step_colliders[at] = pack.prev_colliders[frame_at]
+                                    .lerp(&s.colliders[frame_at], w.0[l]);
                                 s.step_bounds[c].set(l, &s.step_colliders[at]);
                                 last = Some(l);
                             }
@@ -1561,11 +1575,16 @@ impl Ctx<'_> {
                 active,
                 pack.shared,
             );
+            let (colliders, stride, bounds) = match all_end {
+                true => (&s.colliders, stride, &s.bounds),
+                false => (&s.step_colliders, k_all, &s.step_bounds),
+            };
             let input = LaneStep {
                 targets: &s.step_targets,
                 normals: &s.step_normals,
-                colliders: &s.step_colliders,
-                bounds: &s.step_bounds,
+                colliders,
+                stride,
+                bounds,
                 shapes: self.shapes,
                 move_cs: mo.move_cs,
                 rotate_cs: mo.rotate_cs,

@@ -379,8 +379,10 @@ pub(super) struct LaneStep<'a> {
     pub targets: &'a [V3],
     /// Planar normals per point.
     pub normals: &'a [V3],
-    /// The colliders placed at the end of the step, lane after lane (`m` per lane).
+    /// The colliders placed at the end of the step, lane after lane: lane `l`'s from
+    /// `l * stride` (`stride` is `m`, or 0 where every lane has the same).
     pub colliders: &'a [PlacedCollider],
+    pub stride: usize,
     /// Their broad-phase spheres per collider.
     pub bounds: &'a [Bound],
     /// Each rig collider's shape as the lanes see it.
@@ -474,6 +476,7 @@ fn near_sets<T: Lane>(
 fn collide<T: Lane>(
     list: &[usize],
     colliders: &[PlacedCollider],
+    stride: usize,
     bounds: &[Bound],
     shapes: &[LaneShape],
     near: &[M],
@@ -482,7 +485,6 @@ fn collide<T: Lane>(
     r: f32,
     open: T::M,
 ) -> (V3<T>, T::M) {
-    let m = colliders.len() / LANES;
     let mut y = x;
     // `differs(y, x)`, kept up to date lane by lane where a member moves `y` (the only
     // place it changes) rather than compared afresh for every member.
@@ -564,7 +566,7 @@ fn collide<T: Lane>(
         let mut mv = moved.m();
         for l in 0..LANES {
             if ask.0[l] != 0 {
-                let p = colliders[l * m + c].resolve(yf.get(l), qf.get(l), r);
+                let p = colliders[l * stride + c].resolve(yf.get(l), qf.get(l), r);
                 yf.set(l, p);
                 mv.0[l] = if p != xf.get(l) { !0 } else { 0 };
             }
@@ -661,6 +663,7 @@ pub(super) fn step_lanes<T: Lane>(
             let (y, moved) = collide(
                 list,
                 input.colliders,
+                input.stride,
                 input.bounds,
                 input.shapes,
                 near,
@@ -720,6 +723,7 @@ pub(super) fn output_lanes<T: Lane>(
     dev_before: &[V3],
     dev: &[V3],
     colliders: &[PlacedCollider],
+    stride: usize,
     bounds: &[Bound],
     shapes: &[LaneShape],
     out: &mut [V3],
@@ -758,7 +762,9 @@ pub(super) fn output_lanes<T: Lane>(
         let near = &*near;
         let mut open = live_t;
         for pass in 0..3 {
-            let (y, moved) = collide(list, colliders, bounds, shapes, near, x, None, r, open);
+            let (y, moved) = collide(
+                list, colliders, stride, bounds, shapes, near, x, None, r, open,
+            );
             open = open.and(moved);
             x = V3::select(
                 open,
