@@ -152,6 +152,7 @@ impl Transform {
 
 impl core::ops::Mul for Transform {
     type Output = Transform;
+    #[inline]
     fn mul(self, rhs: Transform) -> Transform {
         self.mul_transform(&rhs)
     }

@@ -276,7 +276,7 @@ fn one_chain(rig: &ChainRig, ci: usize) -> ChainRig {
         rotators: Vec::new(),
         rotator_children: Vec::new(),
         lane_groups: Vec::new(),
-        rotator_in_lanes: Vec::new(),
+        scalar_rotators: Vec::new(),
         chain_in_lanes: Vec::new(),
         joint_count: rig.joint_count(),
     }

@@ -52,8 +52,9 @@ pub struct ChainRig {
     pub(crate) rotator_children: Vec<u32>,
     /// Twin chains stepped side by side in SIMD lanes (see [`crate::crowd::chain_lanes`]).
     pub(crate) lane_groups: Vec<crate::crowd::chain_lanes::ChainLaneGroup>,
-    /// Per rotator: written back in a lane group's lanes (with the lanes on).
-    pub(crate) rotator_in_lanes: Vec<bool>,
+    /// The rotators not written back in a lane group's lanes (with the lanes on), in
+    /// order.
+    pub(crate) scalar_rotators: Vec<u32>,
     /// Per chain: stepped in a lane group (with the lanes on).
     pub(crate) chain_in_lanes: Vec<bool>,
     pub(crate) joint_count: usize,
@@ -64,16 +65,10 @@ impl ChainRig {
     /// its bone perpendicular to (its chain's `planar_constraint`), or `None` when its
     /// chain has none (then no step reads a normal of its).
     pub(crate) fn planar_axis(&self, p: usize) -> Option<glam::Vec3> {
-        use super::settings::PlanarAxis;
-        match self.chains[self.chain_of[p] as usize]
+        self.chains[self.chain_of[p] as usize]
             .settings
             .planar_constraint
-        {
-            PlanarAxis::None => None,
-            PlanarAxis::X => Some(glam::Vec3::X),
-            PlanarAxis::Y => Some(glam::Vec3::Y),
-            PlanarAxis::Z => Some(glam::Vec3::Z),
-        }
+            .axis()
     }
 
     /// Compiles `rig` for `skeleton`: resolves bone names, collects each chain's points
@@ -98,7 +93,7 @@ impl ChainRig {
             rotators: Vec::new(),
             rotator_children: Vec::new(),
             lane_groups: Vec::new(),
-            rotator_in_lanes: Vec::new(),
+            scalar_rotators: Vec::new(),
             chain_in_lanes: Vec::new(),
             joint_count: skeleton.len(),
         };
@@ -251,10 +246,13 @@ impl ChainRig {
                 lane_write_back[ci] = true;
             }
         }
-        out.rotator_in_lanes = out
+        let rotator_in_lanes: Vec<bool> = out
             .rotators
             .iter()
             .map(|(_, p, _)| lane_write_back[out.chain_of[*p as usize] as usize])
+            .collect();
+        out.scalar_rotators = (0..out.rotators.len() as u32)
+            .filter(|&r| !rotator_in_lanes[r as usize])
             .collect();
         Ok(out)
     }

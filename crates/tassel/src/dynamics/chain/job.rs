@@ -369,7 +369,11 @@ pub(crate) fn gather_targets(
     normals: &mut [Vec3],
     colliders: &mut [PlacedCollider],
 ) {
-    for p in 0..rig.joint.len() {
+    for (p, axis) in rig.chains.iter().flat_map(|c| {
+        c.points
+            .clone()
+            .map(|p| (p, c.settings.planar_constraint.axis()))
+    }) {
         let j = rig.joint[p];
         let parent = rig.parent[p];
         targets[p] = if j == VIRTUAL {
@@ -388,7 +392,7 @@ pub(crate) fn gather_targets(
         };
         // The normals only where a planar constraint reads them (the others keep what
         // they hold, never read).
-        if let (true, Some(axis)) = (parent != NONE, rig.planar_axis(p)) {
+        if let (true, Some(axis)) = (parent != NONE, axis) {
             let pj = rig.joint[parent as usize] as usize;
             normals[p] = models[pj].rotation * axis;
         }
@@ -778,10 +782,8 @@ pub(crate) fn write_back(
     models: &mut [Transform],
     lanes: bool,
 ) {
-    for (r, (joint, point, kids)) in rig.rotators.iter().enumerate() {
-        if lanes && rig.rotator_in_lanes[r] {
-            continue; // written back in its lane group, before
-        }
+    let mut turn = |r: usize| {
+        let (joint, point, kids) = &rig.rotators[r];
         let j = *joint as usize;
         let p = *point as usize;
         let mut anim = Vec3::ZERO;
@@ -792,7 +794,7 @@ pub(crate) fn write_back(
             sim += normalize_or(out[c] - out[p], Vec3::ZERO);
         }
         if anim.length_squared() < 1e-12 || sim.length_squared() < 1e-12 {
-            continue;
+            return;
         }
         let swing = rotation_arc(anim, sim);
         let new_rot = (swing * models[j].rotation).normalize();
@@ -802,5 +804,11 @@ pub(crate) fn write_back(
             .unwrap_or(Quat::IDENTITY);
         locals[j].rotation = (parent_rot.inverse() * new_rot).normalize();
         models[j].rotation = new_rot;
+    };
+    // With the lanes on, the rotators of lane groups were written back there, before.
+    if lanes {
+        rig.scalar_rotators.iter().for_each(|&r| turn(r as usize));
+    } else {
+        (0..rig.rotators.len()).for_each(turn);
     }
 }

@@ -49,6 +49,18 @@ pub enum PlanarAxis {
     Z,
 }
 
+impl PlanarAxis {
+    /// The plane's normal in the parent's local space (`None`: no constraint).
+    pub(crate) fn axis(self) -> Option<glam::Vec3> {
+        match self {
+            PlanarAxis::None => None,
+            PlanarAxis::X => Some(glam::Vec3::X),
+            PlanarAxis::Y => Some(glam::Vec3::Y),
+            PlanarAxis::Z => Some(glam::Vec3::Z),
+        }
+    }
+}
+
 /// Wind: a push along a world direction with seeded random gusts.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
