@@ -9,7 +9,7 @@
 //! capsule graze whose closed-form entry finds no root and every other shape are left to
 //! the scalar colliders, asked only for the lanes that need them.
 
-use super::entry_lanes::entry;
+use super::entry_lanes::{capsule_entry_out_of_line, sphere_entry};
 use super::lanes::{
     angle_between, closest_params_segment_segment, closest_point_on_segment, differs,
     turned_toward, Lane, Mask, F, LANES, M, Q, V3,
@@ -552,7 +552,14 @@ fn collide<T: Lane>(
             }
             // The entries: in lanes too, but for a capsule's graze whose closed form
             // found no root (the scalar narrow phase bisects there).
-            let (entry, hard) = entry(capsule, y, q, bc, a, b, limit, &contact, ask);
+            let (entry, hard) = match capsule {
+                // A sphere's entry is a few `f32` operations: in line.
+                false => (
+                    sphere_entry(y, q, bc, limit, &contact),
+                    <T::M as Mask>::NONE,
+                ),
+                true => capsule_entry_out_of_line(y, q, a, b, limit, &contact, ask),
+            };
             let slid = ask.and(hard.not());
             y = V3::select(slid, entry, y);
             moved = slid.and(differs(y, x)).or(slid.not().and(moved));

@@ -9,9 +9,11 @@
 //! graze lost to rounding, where the scalar function bisects) is reported `hard` and left
 //! to the scalar narrow phase.
 //!
-//! [`entry`] runs them out of line (in AVX2 where the caller's lane type is the AVX one):
-//! inlined into every copy of the solver step, their `f64` code tripled the crate's
-//! release build time.
+//! [`capsule_entry_out_of_line`] runs the capsule's out of line (in AVX2 where the
+//! caller's lane type is the AVX one): inlined into every copy of the solver step, its
+//! `f64` code tripled the crate's release build time. The sphere's ([`sphere_entry`], a
+//! few `f32` operations) is inlined where it is asked: out of line, the call and its
+//! arguments' trip through memory cost one character about 2 %.
 
 #[cfg(target_arch = "x86_64")]
 use super::avx::Fa;
@@ -311,17 +313,13 @@ pub(super) fn capsule_entry_push<T: Lane>(
     (outside_capsule(slid, a, b, limit, n), hard)
 }
 
-/// The swept entry of a keep-out capsule (`a`–`b`) or sphere (`center`) of `limit` per
-/// lane, for the lanes of `need` ([`capsule_entry_push`], [`sphere_entry`]): the point
-/// each gives, and the capsule lanes left to the scalar narrow phase. Out of line: in
-/// AVX2 for the AVX lane type, else in the portable one (the same bits).
+/// [`capsule_entry_push`] for the lanes of `need`: the point each gives, and the lanes
+/// left to the scalar narrow phase. Out of line: in AVX2 for the AVX lane type, else in
+/// the portable one (the same bits).
 #[inline(always)]
-#[allow(clippy::too_many_arguments)]
-pub(super) fn entry<T: Lane>(
-    capsule: bool,
+pub(super) fn capsule_entry_out_of_line<T: Lane>(
     p: V3<T>,
     prev: V3<T>,
-    center: V3<T>,
     a: V3<T>,
     b: V3<T>,
     limit: T,
@@ -331,7 +329,6 @@ pub(super) fn entry<T: Lane>(
     let args = (
         p.f(),
         prev.f(),
-        center.f(),
         a.f(),
         b.f(),
         limit.f(),
@@ -343,43 +340,33 @@ pub(super) fn entry<T: Lane>(
         // SAFETY: a value of the AVX lane type exists only inside functions compiled with
         // AVX2 after the CPU was found to have it (`crowd/avx.rs`), so the CPU has AVX2.
         #[allow(unsafe_code)]
-        let (e, h) = unsafe { entry_avx2(capsule, args) };
+        let (e, h) = unsafe { entry_avx2(args) };
         return (V3::of(e), <T::M as Mask>::of(h));
     }
-    let (e, h) = entry_portable(capsule, args);
+    let (e, h) = entry_portable(args);
     (V3::of(e), <T::M as Mask>::of(h))
 }
 
-/// [`entry`]'s arguments in the portable lane type.
-type EntryArgs = (V3, V3, V3, V3, V3, F, LaneContact<F>, M);
+/// [`capsule_entry_out_of_line`]'s arguments in the portable lane type.
+type EntryArgs = (V3, V3, V3, V3, F, LaneContact<F>, M);
 
 #[inline(never)]
-fn entry_portable(capsule: bool, args: EntryArgs) -> (V3, M) {
-    entry_in::<F>(capsule, args)
+fn entry_portable(args: EntryArgs) -> (V3, M) {
+    entry_in::<F>(args)
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 #[inline(never)]
-fn entry_avx2(capsule: bool, args: EntryArgs) -> (V3, M) {
-    entry_in::<Fa>(capsule, args)
+fn entry_avx2(args: EntryArgs) -> (V3, M) {
+    entry_in::<Fa>(args)
 }
 
 #[inline(always)]
-fn entry_in<T: Lane>(
-    capsule: bool,
-    (p, prev, center, a, b, limit, contact, need): EntryArgs,
-) -> (V3, M) {
+fn entry_in<T: Lane>((p, prev, a, b, limit, contact, need): EntryArgs) -> (V3, M) {
     let (p, prev, limit) = (V3::<T>::of(p), V3::<T>::of(prev), T::of(limit));
     let contact = LaneContact::<T>::of(&contact);
-    if capsule {
-        let (a, b) = (V3::<T>::of(a), V3::<T>::of(b));
-        let (e, h) = capsule_entry_push(p, prev, a, b, limit, &contact);
-        (e.f(), h.and(<T::M as Mask>::of(need)).m())
-    } else {
-        (
-            sphere_entry(p, prev, V3::of(center), limit, &contact).f(),
-            M::NONE,
-        )
-    }
+    let (a, b) = (V3::<T>::of(a), V3::<T>::of(b));
+    let (e, h) = capsule_entry_push(p, prev, a, b, limit, &contact);
+    (e.f(), h.and(<T::M as Mask>::of(need)).m())
 }
