@@ -69,8 +69,9 @@ struct Pack {
 }
 
 impl Pack {
-    /// Where lane `l`'s placed colliders start in `prev_colliders` and in the scratch's
-    /// `colliders`, over `l`: `m`, or 0 where every lane has the same (`shared`).
+    /// How far apart two neighbouring lanes' placed colliders are in `prev_colliders`
+    /// and in the scratch's `colliders` (lane `l`'s start at `l` times it): `m`, or 0
+    /// where every lane has the same (`shared`).
     fn collider_stride(&self) -> usize {
         if self.shared {
             0
@@ -688,9 +689,9 @@ impl Twins {
                 }
             }
         }
-        // The same colliders in every lane: kept once (`Pack::collider_stride`).
+        // The same colliders in every lane: kept once (`Pack::collider_stride`), and each
+        // bound computed once.
         s.colliders[..m].copy_from_slice(colliders);
-        // The same colliders in every lane: each bound computed once.
         for (b, c) in s.bounds.iter_mut().zip(colliders) {
             *b = Bound::splat(c);
         }

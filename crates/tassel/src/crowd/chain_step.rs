@@ -382,6 +382,7 @@ pub(super) struct LaneStep<'a> {
     /// The colliders placed at the end of the step, lane after lane: lane `l`'s from
     /// `l * stride` (`stride` is `m`, or 0 where every lane has the same).
     pub colliders: &'a [PlacedCollider],
+    /// See `colliders`.
     pub stride: usize,
     /// Their broad-phase spheres per collider.
     pub bounds: &'a [Bound],

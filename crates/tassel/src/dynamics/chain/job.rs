@@ -57,7 +57,7 @@ pub struct ChainState {
     /// Each lane group's state, authoritative for its chains while `in_lanes`.
     lanes: Vec<ChainLanes>,
     in_lanes: bool,
-    /// Scratch of the lanes' write-back: each rotator's new model rotation.
+    /// Scratch of the lanes' write-back: each rotator row between its two passes.
     turned: Vec<crate::crowd::chain_lanes::TurnedRow>,
 }
 
