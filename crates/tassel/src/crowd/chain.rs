@@ -1035,7 +1035,7 @@ fn model_pose_lanes<T: Lane>(
 fn targets_lanes<T: Lane>(sk: &Skeleton, rig: &ChainRig, s: &mut Scratch) {
     let models = &s.lane_models;
     let y = V3::<T>::splat(Vec3::Y);
-    for p in 0..rig.joint.len() {
+    for (p, axis) in rig.points_and_planar_axes() {
         let j = rig.joint[p];
         let parent = rig.parent[p];
         s.targets[p] = if j == VIRTUAL {
@@ -1051,7 +1051,7 @@ fn targets_lanes<T: Lane>(sk: &Skeleton, rig: &ChainRig, s: &mut Scratch) {
             models[j as usize].t
         };
         // The planar normal only where a step reads it (its chain's constraint is on).
-        if let (true, Some(axis)) = (parent != NONE, rig.planar_axis(p)) {
+        if let (true, Some(axis)) = (parent != NONE, axis) {
             let pj = rig.joint[parent as usize] as usize;
             let axis = V3::splat(axis);
             s.normals[p] = Q::<T>::of(models[pj].r).mul_vec3(axis).f();

@@ -71,6 +71,17 @@ impl ChainRig {
             .axis()
     }
 
+    /// Every point, chain after chain, with its chain's planar axis ([`Self::planar_axis`],
+    /// looked up once per chain rather than per point).
+    pub(crate) fn points_and_planar_axes(
+        &self,
+    ) -> impl Iterator<Item = (usize, Option<glam::Vec3>)> + '_ {
+        self.chains.iter().flat_map(|c| {
+            let axis = c.settings.planar_constraint.axis();
+            c.points.clone().map(move |p| (p, axis))
+        })
+    }
+
     /// Compiles `rig` for `skeleton`: resolves bone names, collects each chain's points
     /// depth-first, evaluates the parameter curves. Errors name the chain or collider.
     pub fn new(skeleton: &Skeleton, rig: &RigSettings) -> Result<Self> {

@@ -369,11 +369,7 @@ pub(crate) fn gather_targets(
     normals: &mut [Vec3],
     colliders: &mut [PlacedCollider],
 ) {
-    for (p, axis) in rig.chains.iter().flat_map(|c| {
-        c.points
-            .clone()
-            .map(|p| (p, c.settings.planar_constraint.axis()))
-    }) {
+    for (p, axis) in rig.points_and_planar_axes() {
         let j = rig.joint[p];
         let parent = rig.parent[p];
         targets[p] = if j == VIRTUAL {
