@@ -2,7 +2,7 @@
 
 use std::sync::Arc;
 use std::time::Instant;
-use tassel::crowd::{ChainCrowd, CrowdPose, SimdUse, VrmCrowd};
+use tassel::crowd::{ChainCrowd, CrowdPose, Isa, SimdUse, VrmCrowd};
 use tassel::dynamics::chain::ChainRig;
 use tassel::dynamics::vrm::{VrmMode, VrmOptions, VrmRig};
 use tassel::dynamics::RigSettings;
@@ -26,7 +26,7 @@ pub struct Args {
     cloth: bool,
     /// A crowd of this many characters, each on its own phase of the motion, advanced
     /// together every frame: chains and VRM springs (any mode) through the crowd path
-    /// (`tassel::crowd`, lane groups of 8), the cloth one `CharacterSim` each.
+    /// (`tassel::crowd`, lane groups of 16), the cloth one `CharacterSim` each.
     #[arg(long)]
     crowd: Option<usize>,
     /// Threads sharing the crowd.
@@ -37,9 +37,11 @@ pub struct Args {
     #[arg(long, requires = "crowd")]
     compare: bool,
     /// Which code runs the solvers that have a lane path (VRM springs, twin chains, the
-    /// cloth's contact tests) in one character: `scalar` is the readable reference (the
-    /// same bits, slower).
-    #[arg(long, value_enum, default_value_t = SimdBench::Auto, conflicts_with = "crowd")]
+    /// cloth's contact tests; with --crowd, the crowd): `scalar` is the readable
+    /// reference (the same bits, slower; one character only), `portable` lanes without
+    /// AVX, `avx2` lanes with AVX2 at most (how a CPU without AVX-512 runs `auto`),
+    /// `auto` the widest the CPU has.
+    #[arg(long, value_enum, default_value_t = SimdBench::Auto)]
     simd: SimdBench,
 }
 
@@ -47,7 +49,27 @@ pub struct Args {
 enum SimdBench {
     Scalar,
     Portable,
+    Avx2,
     Auto,
+}
+
+impl SimdBench {
+    fn simd_use(self) -> SimdUse {
+        match self {
+            SimdBench::Scalar => SimdUse::Scalar,
+            SimdBench::Portable => SimdUse::Portable,
+            SimdBench::Avx2 => SimdUse::Avx2,
+            SimdBench::Auto => SimdUse::Auto,
+        }
+    }
+
+    /// What runs, for the report: "scalar reference" or "lanes (AVX-512)" and the like.
+    fn describe(self) -> String {
+        match self {
+            SimdBench::Scalar => "scalar reference".into(),
+            _ => format!("lanes ({})", Isa::of(self.simd_use()).name()),
+        }
+    }
 }
 
 #[derive(Clone, Copy, clap::ValueEnum)]
@@ -144,11 +166,7 @@ pub fn run(a: Args) -> Result<(), String> {
         return crowd(&a, n);
     }
     let (mut sim, simulated, what) = character(&a)?;
-    sim.set_simd(match a.simd {
-        SimdBench::Scalar => SimdUse::Scalar,
-        SimdBench::Portable => SimdUse::Portable,
-        SimdBench::Auto => SimdUse::Auto,
-    });
+    sim.set_simd(a.simd.simd_use());
     let rest = sim.skeleton().rest().to_vec();
     let dt = 1.0 / 60.0;
     let mut f = 0usize;
@@ -163,11 +181,7 @@ pub fn run(a: Args) -> Result<(), String> {
     };
     let samples = sorted_samples(a.runs, a.frames, &mut one_run)?;
     let median = samples[samples.len() / 2];
-    let code = match a.simd {
-        SimdBench::Scalar => "scalar reference",
-        SimdBench::Portable => "lanes without AVX2",
-        SimdBench::Auto => "lanes",
-    };
+    let code = a.simd.describe();
     say!("tassel bench: {what}, single thread, {code}");
     say!(
         "  {simulated} simulated joints; median of {} runs x {} frames",
@@ -200,6 +214,13 @@ fn crowd(a: &Args, n: usize) -> Result<(), String> {
     let threads = a.threads.min(n);
     let frames = a.frames.max(1);
     let crowd_path = !a.cloth;
+    if crowd_path && a.simd == SimdBench::Scalar {
+        return Err(
+            "--simd scalar: the crowd path has only lanes (its scalar reference is one \
+             CharacterSim per character: --compare times it)"
+                .into(),
+        );
+    }
     let reference = if !crowd_path || a.compare {
         Some(sims_crowd(a, n, threads, frames)?)
     } else {
@@ -211,10 +232,20 @@ fn crowd(a: &Args, n: usize) -> Result<(), String> {
         } else {
             chain_crowd(a, n, threads, frames)?
         };
-        (what, joints, t, "crowd path")
+        (
+            what,
+            joints,
+            t,
+            format!("crowd path, {}", a.simd.describe()),
+        )
     } else {
         let (what, joints, t) = reference.clone().expect("timed above");
-        (what, joints, t, "one CharacterSim per character")
+        (
+            what,
+            joints,
+            t,
+            "one CharacterSim per character".to_string(),
+        )
     };
     say!(
         "tassel bench --crowd: {what}; {path}; median of {} runs x {frames} frames",
@@ -248,6 +279,7 @@ fn chain_crowd(
     let rig = ChainRig::new(&sk, &settings).map_err(|e| e.to_string())?;
     let rest = sk.rest().to_vec();
     let mut crowd = ChainCrowd::new(Arc::new(sk), Arc::new(rig)).map_err(|e| e.to_string())?;
+    crowd.set_simd(a.simd.simd_use());
     for _ in 0..n {
         crowd.add();
     }
@@ -304,6 +336,7 @@ fn vrm_crowd(
     let rig = VrmRig::new(&sk, &bones, options).map_err(|e| e.to_string())?;
     let rest = sk.rest().to_vec();
     let mut crowd = VrmCrowd::new(Arc::new(sk), Arc::new(rig)).map_err(|e| e.to_string())?;
+    crowd.set_simd(a.simd.simd_use());
     for _ in 0..n {
         crowd.add();
     }
@@ -330,7 +363,8 @@ fn sims_crowd(
     let mut joints = 0;
     let mut what = String::new();
     for _ in 0..n {
-        let (sim, j, w) = character(a)?;
+        let (mut sim, j, w) = character(a)?;
+        sim.set_simd(a.simd.simd_use());
         sims.push(sim);
         (joints, what) = (j, w);
     }

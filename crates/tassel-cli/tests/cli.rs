@@ -588,7 +588,7 @@ fn simulate_builtin_lists_every_solver_and_is_frame_rate_independent() {
             .as_array()
             .unwrap()
             .iter()
-            .filter(|s| s["frame"].as_u64().unwrap() as u32 * 6 % hz == 0)
+            .filter(|s| (s["frame"].as_u64().unwrap() as u32 * 6).is_multiple_of(hz))
             .map(|s| {
                 let root = v3(&s["root_pos"]);
                 let tails = s["tail_world_pos"]

@@ -237,7 +237,7 @@ impl<'a> Writer<'a> {
 
     pub(crate) fn view(&mut self, bytes: &[u8], target: Option<u32>) -> usize {
         let bin = &mut self.src.buffers[0];
-        while bin.len() % 4 != 0 {
+        while !bin.len().is_multiple_of(4) {
             bin.push(0);
         }
         let offset = bin.len();
@@ -293,7 +293,7 @@ fn merge_buffers(src: &ExportSource) -> Result<ExportSource, GltfError> {
     let mut bin: Vec<u8> = Vec::new();
     let mut offsets = Vec::new();
     for b in &src.buffers {
-        while bin.len() % 8 != 0 {
+        while !bin.len().is_multiple_of(8) {
             bin.push(0);
         }
         offsets.push(bin.len());
@@ -572,7 +572,7 @@ fn append(obj: &mut Value, key: &str, items: Vec<Value>) {
 
 fn write_glb(mut doc: ExportSource) -> Result<Vec<u8>, GltfError> {
     let mut bin = std::mem::take(&mut doc.buffers[0]);
-    while bin.len() % 4 != 0 {
+    while !bin.len().is_multiple_of(4) {
         bin.push(0);
     }
     if bin.is_empty() {

@@ -97,7 +97,7 @@ pub(crate) fn read_meshes(
                 Some(ix) => ix.into_u32().collect(),
                 None => (0..vertices.len() as u32).collect(),
             };
-            if flat.len() % 3 != 0 {
+            if !flat.len().is_multiple_of(3) {
                 return Err(invalid(format!(
                     "mesh '{name}': {} indices is not a whole number of triangles",
                     flat.len()

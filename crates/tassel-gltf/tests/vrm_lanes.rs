@@ -25,7 +25,12 @@ fn compare(
         step_rate,
         ..Default::default()
     };
-    let ways = [SimdUse::Scalar, SimdUse::Portable, SimdUse::Auto];
+    let ways = [
+        SimdUse::Scalar,
+        SimdUse::Portable,
+        SimdUse::Avx2,
+        SimdUse::Auto,
+    ];
     let mut sims: Vec<CharacterSim> = ways
         .iter()
         .map(|&w| {

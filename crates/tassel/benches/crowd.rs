@@ -7,7 +7,7 @@
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use std::hint::black_box;
 use std::sync::Arc;
-use tassel::crowd::{ChainCrowd, CrowdPose, VrmCrowd};
+use tassel::crowd::{ChainCrowd, CrowdPose, SimdUse, VrmCrowd};
 use tassel::dynamics::chain::ChainRig;
 use tassel::dynamics::vrm::{VrmOptions, VrmRig};
 use tassel::dynamics::RigSettings;
@@ -33,10 +33,15 @@ fn vrm_crowd(c: &mut Criterion) {
     let mut g = c.benchmark_group("vrm_crowd_64");
     g.throughput(Throughput::Elements(joints));
     let mut f = 0u32;
-    // The AVX2 path (where the CPU has it) and the baseline SSE2 path: the same bits.
-    for (name, avx2) in [("crowd_path", true), ("crowd_path_sse2", false)] {
+    // The widest lanes the CPU has, AVX2 at most, and the baseline SSE2 path: the same
+    // bits.
+    for (name, simd) in [
+        ("crowd_path", SimdUse::Auto),
+        ("crowd_path_avx2", SimdUse::Avx2),
+        ("crowd_path_sse2", SimdUse::Portable),
+    ] {
         let mut crowd = VrmCrowd::new(Arc::new(sk.clone()), rig.clone()).unwrap();
-        crowd.set_avx2(avx2);
+        crowd.set_simd(simd);
         for _ in 0..N {
             crowd.add();
         }

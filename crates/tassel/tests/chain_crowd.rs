@@ -6,7 +6,8 @@ mod common;
 
 use glam::Vec3;
 use std::sync::Arc;
-use tassel::crowd::{ChainCrowd, CrowdPose};
+use tassel::crowd::lanes::LANES;
+use tassel::crowd::{ChainCrowd, CrowdPose, SimdUse};
 use tassel::dynamics::chain::{ChainRig, TimeMode, Wind};
 use tassel::dynamics::RigSettings;
 use tassel::{builtin, CharacterSim, Skeleton, Transform};
@@ -156,13 +157,13 @@ fn chain_crowd_is_the_same_on_one_and_two_threads_and_without_avx2() {
     let rig = Arc::new(ChainRig::new(&sk, &settings).unwrap());
     let sk = Arc::new(sk);
     let n = 37;
-    let run = |threads: usize, avx2: bool| -> Vec<u32> {
+    let run = |threads: usize, simd: SimdUse| -> Vec<u32> {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
             .build()
             .unwrap();
         let mut crowd = ChainCrowd::new(sk.clone(), rig.clone()).unwrap();
-        crowd.set_avx2(avx2);
+        crowd.set_simd(simd);
         for _ in 0..n {
             crowd.add();
         }
@@ -186,10 +187,19 @@ fn chain_crowd_is_the_same_on_one_and_two_threads_and_without_avx2() {
             .map(f32::to_bits)
             .collect()
     };
-    let one = run(1, true);
-    assert_eq!(one, run(2, true), "1 vs 2 threads");
-    assert_eq!(one, run(2, true), "run to run");
-    assert_eq!(one, run(2, false), "with and without AVX2");
+    let one = run(1, SimdUse::Auto);
+    assert_eq!(one, run(2, SimdUse::Auto), "1 vs 2 threads");
+    assert_eq!(one, run(2, SimdUse::Auto), "run to run");
+    assert_eq!(
+        one,
+        run(2, SimdUse::Avx2),
+        "the widest lanes and AVX2 at most"
+    );
+    assert_eq!(
+        one,
+        run(2, SimdUse::Portable),
+        "the widest lanes and no AVX"
+    );
 }
 
 /// Bad input names the character; its lane group keeps its state, the others step, and
@@ -352,7 +362,9 @@ fn chain_crowd_names_the_joint_whose_model_pose_overflows() {
     let rig = Arc::new(ChainRig::new(&sk, &settings).unwrap());
     let sk = Arc::new(sk);
     let mut crowd = ChainCrowd::new(sk.clone(), rig).unwrap();
-    for _ in 0..12 {
+    // Character 3 in the first lane group, `LANES + 2` in the second.
+    let other = LANES + 2;
+    for _ in 0..LANES + 4 {
         crowd.add();
     }
     let rest = sk.rest().to_vec();
@@ -375,7 +387,7 @@ fn chain_crowd_names_the_joint_whose_model_pose_overflows() {
         .position(|t| !t.is_finite())
         .expect("the pose overflows");
     let tip = crowd.rig().point_count() - 1;
-    let before = crowd.point(10, tip).unwrap();
+    let before = crowd.point(other, tip).unwrap();
     let err = crowd
         .frame(1.0 / 60.0, |i| CrowdPose {
             transform: Transform::from_translation(Vec3::X * i as f32),
@@ -389,7 +401,7 @@ fn chain_crowd_names_the_joint_whose_model_pose_overflows() {
         sk.name(first)
     );
     assert_ne!(
-        crowd.point(10, tip).unwrap(),
+        crowd.point(other, tip).unwrap(),
         before,
         "the second lane group stepped"
     );

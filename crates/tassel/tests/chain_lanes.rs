@@ -5,6 +5,7 @@
 
 mod common;
 
+use tassel::crowd::lanes::LANES;
 use tassel::crowd::SimdUse;
 use tassel::dynamics::chain::{ChainRig, TimeMode};
 use tassel::dynamics::RigSettings;
@@ -17,8 +18,9 @@ fn motion(sk: &Skeleton, swing: usize, f: usize, locals: &mut [Transform]) -> Tr
     common::sway(sk, swing, f as f32 / 60.0, jump, locals)
 }
 
-/// One character per way of running the chains (scalar, portable lanes, AVX2 lanes where
-/// the CPU has them, and one switched between scalar and lanes every 37 frames) through
+/// One character per way of running the chains (scalar, portable lanes, AVX2 lanes at
+/// most and the widest lanes where the CPU has them, and one switched between scalar and
+/// lanes every 37 frames) through
 /// `frames` frames with a reset at frame 400: every local and model transform, every
 /// chain point and the reset count the same after every frame. The joints `squashed`
 /// have no length (their local translation zero) in frames 100 to 249. Returns the
@@ -33,6 +35,7 @@ fn assert_lanes_match(
     let ways = [
         SimdUse::Scalar,
         SimdUse::Portable,
+        SimdUse::Avx2,
         SimdUse::Auto,
         SimdUse::Scalar,
     ];
@@ -56,7 +59,7 @@ fn assert_lanes_match(
             } else {
                 SimdUse::Auto
             };
-            sims[3].set_simd(simd);
+            sims[4].set_simd(simd);
         }
         let component = motion(sk, swing, f, &mut locals);
         if (100..250).contains(&f) {
@@ -122,18 +125,22 @@ fn twin_chains_in_lanes_keep_a_bone_of_no_length_as_animated() {
 fn twin_chains_in_lanes_give_the_scalar_bits_on_the_bench_rig() {
     let (sk, rig) = builtin::bench_character(16, 8, 8);
     let chains = ChainRig::new(&sk, &rig).unwrap();
-    assert_eq!(chains.lane_groups(), 2, "16 twins: two groups of eight");
+    assert_eq!(
+        chains.lane_groups(),
+        16usize.div_ceil(LANES),
+        "16 twins: groups of {LANES}"
+    );
     let swung = assert_lanes_match(&sk, &rig, 3, 600, &[]);
     assert!(swung > 0.02, "chains barely moved ({swung} m)");
 }
 
 /// Twins with every chain feature (three per feature, so groups of three), beside chains
 /// the lanes do not take (one of a kind, one that collides with the world) and a group
-/// split in two (eleven twins: eight and three); boxes, a plane, a keep-inside sphere, a
-/// turned capsule.
+/// split (twenty-one twins: sixteen and five, or eight, eight and five); boxes, a plane, a
+/// keep-inside sphere, a turned capsule.
 #[test]
 fn twin_chains_in_lanes_give_the_scalar_bits_with_every_feature() {
-    let (sk, mut rig) = builtin::bench_character(40, 6, 6);
+    let (sk, mut rig) = builtin::bench_character(50, 6, 6);
     for (c, ch) in rig.chains.iter_mut().enumerate() {
         ch.stiffness = 0.2;
         ch.teleport_distance = 2.0;
@@ -143,13 +150,16 @@ fn twin_chains_in_lanes_give_the_scalar_bits_with_every_feature() {
             0..=26 => common::chain_feature(ch, c / 3, c as u64),
             27 => ch.damping = 0.3,          // one of a kind: scalar
             28 => ch.world_collision = true, // the lanes have no world: scalar
-            _ => {}                          // eleven plain twins: 8 + 3
+            _ => {}                          // twenty-one plain twins
         }
     }
     common::every_collider_shape(&mut rig);
     let chains = ChainRig::new(&sk, &rig).unwrap();
-    // Nine features of three, the plain chains (29, 30..=39): 29 and 30..=36, then 37..=39.
-    assert_eq!(chains.lane_groups(), 11);
+    // Nine features of three, the 21 plain chains 29..=49 in groups of `LANES` (16: 29..=44
+    // and 45..=49; 8: three groups).
+    // A group split (checked when compiled).
+    const { assert!(!21usize.is_multiple_of(LANES)) };
+    assert_eq!(chains.lane_groups(), 9 + 21usize.div_ceil(LANES));
     let swung = assert_lanes_match(&sk, &rig, 2, 600, &[]);
     assert!(swung > 0.02, "chains barely moved ({swung} m)");
 }

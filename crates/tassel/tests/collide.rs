@@ -42,7 +42,7 @@ fn slides(
             continue;
         }
         // Half of them purely tangential: the case that stuck most.
-        let inward = if rng.next_u64() % 2 == 0 {
+        let inward = if rng.next_u64().is_multiple_of(2) {
             0.0
         } else {
             rng.range_f32(-0.2e-3, 0.5e-3)

@@ -222,13 +222,13 @@ fn vrm_crowd_is_the_same_on_one_and_two_threads() {
     let (sk, bones) = builtin::bench_vrm(8, 6, 8);
     let rig = Arc::new(VrmRig::new(&sk, &bones, VrmOptions::spec()).unwrap());
     let sk = Arc::new(sk);
-    let run = |threads: usize, avx2: bool| -> Vec<u32> {
+    let run = |threads: usize, simd: SimdUse| -> Vec<u32> {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
             .build()
             .unwrap();
         let mut crowd = VrmCrowd::new(sk.clone(), rig.clone()).unwrap();
-        crowd.set_avx2(avx2);
+        crowd.set_simd(simd);
         for _ in 0..37 {
             crowd.add();
         }
@@ -252,10 +252,19 @@ fn vrm_crowd_is_the_same_on_one_and_two_threads() {
             .map(f32::to_bits)
             .collect()
     };
-    let one = run(1, true);
-    assert_eq!(one, run(2, true), "1 vs 2 threads");
-    assert_eq!(one, run(2, true), "run to run");
-    assert_eq!(one, run(2, false), "with and without AVX2");
+    let one = run(1, SimdUse::Auto);
+    assert_eq!(one, run(2, SimdUse::Auto), "1 vs 2 threads");
+    assert_eq!(one, run(2, SimdUse::Auto), "run to run");
+    assert_eq!(
+        one,
+        run(2, SimdUse::Avx2),
+        "the widest lanes and AVX2 at most"
+    );
+    assert_eq!(
+        one,
+        run(2, SimdUse::Portable),
+        "the widest lanes and no AVX"
+    );
 }
 
 /// Bad input names the character; its lane group keeps its state, the others step, and

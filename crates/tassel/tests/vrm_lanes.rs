@@ -5,6 +5,7 @@
 mod common;
 
 use glam::{Quat, Vec3};
+use tassel::crowd::lanes::LANES;
 use tassel::crowd::SimdUse;
 use tassel::dynamics::vrm::{
     VrmCollider, VrmColliderGroup, VrmJoint, VrmMode, VrmOptions, VrmRig, VrmShape, VrmSpring,
@@ -50,7 +51,12 @@ fn assert_lanes_match(
         teleport_distance: 2.0,
         ..Default::default()
     };
-    let ways = [SimdUse::Scalar, SimdUse::Portable, SimdUse::Auto];
+    let ways = [
+        SimdUse::Scalar,
+        SimdUse::Portable,
+        SimdUse::Avx2,
+        SimdUse::Auto,
+    ];
     let mut sims: Vec<CharacterSim> = ways
         .iter()
         .map(|&w| {
@@ -346,18 +352,21 @@ fn every_part() -> (Skeleton, VrmSpringBones) {
 fn lanes_give_the_scalar_bits_with_every_part_of_the_plan() {
     let (sk, bones) = every_part();
     let rig = VrmRig::new(&sk, &bones, VrmOptions::default()).unwrap();
-    // By hand: colliders "a" without centre: 9 hair springs and "b" (10 columns, two
-    // groups); colliders "b": h6, h9, h10 (one), h7 with its centre (one), h8 with its
-    // centre (one); "y" hangs below "b"'s link b1: a group of its own after them.
-    assert_eq!(rig.lane_groups(), 6);
+    // By hand: colliders "a" without centre: 9 hair springs and "b" (10 columns: one group
+    // of 16 lanes, two of 8); colliders "b": h6, h9, h10 (one), h7 with its centre (one),
+    // h8 with its centre (one); "y" hangs below "b"'s link b1: a group of its own after
+    // them.
+    assert_eq!(rig.lane_groups(), 10usize.div_ceil(LANES) + 4);
     assert_lanes_match_in_every_mode(&sk, &bones);
 }
 
 #[test]
 fn lanes_give_the_scalar_bits_on_the_bench_rig() {
-    let (sk, bones) = builtin::bench_vrm(16, 8, 8);
+    // 24 springs with the same colliders: one full group and one of 8 (16 lanes), or
+    // three full groups (8 lanes).
+    let (sk, bones) = builtin::bench_vrm(24, 8, 8);
     let rig = VrmRig::new(&sk, &bones, VrmOptions::default()).unwrap();
-    assert_eq!(rig.lane_groups(), 2, "16 springs with the same colliders");
+    assert_eq!(rig.lane_groups(), 24usize.div_ceil(LANES));
     assert_lanes_match_in_every_mode(&sk, &bones);
 }
 

@@ -1,46 +1,62 @@
-//! The crowd's AVX lane type: [`Fa`], one `__m256` per [`F`], every operation one
-//! 256-bit instruction.
+//! The crowd's AVX2 lane type: [`Fa`], two `__m256` per [`F`] (its sixteen lanes in two
+//! halves), every operation two 256-bit instructions.
 //!
-//! Why it exists: the lane types over [`F`] (arrays of eight `f32`) leave vectorisation to
+//! Why it exists: the lane types over [`F`] (arrays of `f32`) leave vectorisation to
 //! LLVM, which does it well in small functions but, in a whole inlined VRM step, splits a
 //! good part of it into 128-bit halves and per-lane shuffles (measured: in `step_avx2` a
 //! third of the arithmetic was 128-bit, with ~1 000 shuffles and inserts). Written with
-//! the intrinsics, every lane operation is one instruction whatever the context.
+//! the intrinsics, every lane operation is one instruction per half whatever the
+//! context. A CPU with AVX-512 runs `crowd/avx512.rs`'s type instead (one instruction
+//! for all sixteen lanes); this one is how the others run ([`crate::crowd::SimdUse::Avx2`]
+//! forces it).
 //!
 //! Each operation is the IEEE operation per lane that [`F`]'s is (add, subtract,
 //! multiply, divide, square root: correctly rounded; negation and `abs`: the sign bit;
 //! comparisons: ordered, `!=` unordered as Rust's; select: bitwise), so both types give
 //! the same bits; `tests` checks it operation by operation.
 //!
-//! **Soundness.** The intrinsics need AVX. [`Fa`] and [`Ma`] are private to the crowd and
+//! **Soundness.** The intrinsics need AVX2. [`Fa`] and [`Ma`] are private to the crowd and
 //! only ever created inside functions compiled with `#[target_feature(enable = "avx2")]`
-//! that are called after `is_x86_feature_detected!("avx2")` said yes (`Ctx::run` in
-//! `vrm.rs`, `Ctx::step` and `Ctx::model_pose` in `chain.rs`, `Pass::run_avx2` and
-//! `limit_angles_avx2` in `cloth_lanes.rs`; `entry_avx2` in `entry_lanes.rs`, called only
-//! where an [`Fa`] exists already; the tests below check the same first), so no
-//! AVX instruction runs on a CPU without it. The operations are `#[inline(always)]` so
-//! that they are compiled inside those functions.
+//! that are called where [`crate::crowd::Isa::of`] said [`crate::crowd::Isa::Avx2`],
+//! which it says only after `is_x86_feature_detected!("avx2")` said yes (the `*_avx2`
+//! functions of `vrm.rs`, `chain.rs`, `chain_lanes.rs`, `spring_lanes.rs`, `lanes.rs`
+//! and `cloth_lanes.rs`; `entry_avx2` in `entry_lanes.rs`, called only where an [`Fa`]
+//! exists already; the tests below check the same first), so no AVX instruction runs
+//! on a CPU without it. The operations are `#[inline(always)]` so that they are
+//! compiled inside those functions.
 #![allow(unsafe_code)]
 
 use super::lanes::{Lane, Mask, F, M};
+use super::Isa;
 use std::arch::x86_64::*;
 use std::ops::{Add, Div, Mul, Neg, Sub};
 
-/// Eight `f32` lanes in one AVX register.
+/// Sixteen `f32` lanes in two AVX registers (lanes 0–7, 8–15).
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct Fa(__m256);
+pub(crate) struct Fa(__m256, __m256);
 
-/// A per-lane condition of [`Fa`] (all bits set when true).
+/// A per-lane condition of [`Fa`] (all bits set when true), in the same two halves.
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct Ma(__m256);
+pub(crate) struct Ma(__m256, __m256);
 
 impl PartialEq for Ma {
     #[inline(always)]
     fn eq(&self, o: &Ma) -> bool {
         // SAFETY: see the module's documentation. Every lane of a mask is all ones or all
         // zeros (comparisons, and `M`'s, make them so), so its sign bits are the mask.
-        unsafe { _mm256_movemask_ps(self.0) == _mm256_movemask_ps(o.0) }
+        unsafe {
+            _mm256_movemask_ps(self.0) == _mm256_movemask_ps(o.0)
+                && _mm256_movemask_ps(self.1) == _mm256_movemask_ps(o.1)
+        }
     }
+}
+
+/// `$intr` on both halves.
+macro_rules! halves {
+    ($intr:ident, $a:expr, $b:expr) => {
+        // SAFETY: see the module's documentation (only run where AVX2 is).
+        unsafe { ($intr($a.0, $b.0), $intr($a.1, $b.1)) }
+    };
 }
 
 macro_rules! binary {
@@ -49,8 +65,8 @@ macro_rules! binary {
             type Output = Fa;
             #[inline(always)]
             fn $f(self, o: Fa) -> Fa {
-                // SAFETY: see the module's documentation (only run where AVX is).
-                Fa(unsafe { $intr(self.0, o.0) })
+                let (lo, hi) = halves!($intr, self, o);
+                Fa(lo, hi)
             }
         }
     };
@@ -64,56 +80,82 @@ impl Neg for Fa {
     type Output = Fa;
     #[inline(always)]
     fn neg(self) -> Fa {
-        // SAFETY: see the module's documentation. Flips the sign bit, as `-x` does.
-        Fa(unsafe { _mm256_xor_ps(self.0, _mm256_set1_ps(-0.0)) })
+        // Flips the sign bit, as `-x` does.
+        let (lo, hi) = halves!(_mm256_xor_ps, self, Fa::splat(-0.0));
+        Fa(lo, hi)
+    }
+}
+
+impl Fa {
+    /// `cmp` on both halves.
+    #[inline(always)]
+    fn cmp<const P: i32>(self, o: Fa) -> Ma {
+        // SAFETY: see the module's documentation.
+        unsafe {
+            Ma(
+                _mm256_cmp_ps::<P>(self.0, o.0),
+                _mm256_cmp_ps::<P>(self.1, o.1),
+            )
+        }
     }
 }
 
 impl Lane for Fa {
     type M = Ma;
-    const AVX: bool = true;
+    const ISA: Isa = Isa::Avx2;
     #[inline(always)]
     fn splat(v: f32) -> Fa {
         // SAFETY: see the module's documentation.
-        Fa(unsafe { _mm256_set1_ps(v) })
+        let h = unsafe { _mm256_set1_ps(v) };
+        Fa(h, h)
     }
     #[inline(always)]
     fn of(f: F) -> Fa {
-        // SAFETY: `F` is eight `f32` aligned to 32 bytes; an aligned load of them. (A
-        // load needs no AVX state beyond what the module's documentation guarantees.)
-        Fa(unsafe { _mm256_load_ps(f.0.as_ptr()) })
+        // SAFETY: `F` is sixteen `f32` aligned to 64 bytes; two aligned loads of its halves
+        // (the second 32 bytes on). (A load needs no AVX state beyond what the module's
+        // documentation guarantees.)
+        unsafe {
+            Fa(
+                _mm256_load_ps(f.0.as_ptr()),
+                _mm256_load_ps(f.0.as_ptr().add(8)),
+            )
+        }
     }
     #[inline(always)]
     fn f(self) -> F {
-        let mut f = F([0.0; 8]);
-        // SAFETY: an aligned store into `F`'s eight `f32`, aligned to 32 bytes.
-        unsafe { _mm256_store_ps(f.0.as_mut_ptr(), self.0) };
+        let mut f = F([0.0; 16]);
+        // SAFETY: two aligned stores into `F`'s halves (64-byte aligned, 32 bytes each).
+        unsafe {
+            _mm256_store_ps(f.0.as_mut_ptr(), self.0);
+            _mm256_store_ps(f.0.as_mut_ptr().add(8), self.1);
+        }
         f
     }
     #[inline(always)]
     fn sqrt(self) -> Fa {
         // SAFETY: see the module's documentation.
-        Fa(unsafe { _mm256_sqrt_ps(self.0) })
+        unsafe { Fa(_mm256_sqrt_ps(self.0), _mm256_sqrt_ps(self.1)) }
     }
     #[inline(always)]
     fn abs(self) -> Fa {
-        // SAFETY: see the module's documentation. Clears the sign bit, as `f32::abs`.
-        Fa(unsafe { _mm256_andnot_ps(_mm256_set1_ps(-0.0), self.0) })
+        // Clears the sign bit, as `f32::abs`.
+        let (lo, hi) = halves!(_mm256_andnot_ps, Fa::splat(-0.0), self);
+        Fa(lo, hi)
     }
     #[inline(always)]
     fn lt(self, o: Fa) -> Ma {
-        // SAFETY: see the module's documentation. Ordered: false with NaN, as `<`.
-        Ma(unsafe { _mm256_cmp_ps::<_CMP_LT_OQ>(self.0, o.0) })
+        // Ordered: false with NaN, as `<`.
+        self.cmp::<_CMP_LT_OQ>(o)
     }
     #[inline(always)]
     fn le(self, o: Fa) -> Ma {
-        // SAFETY: see the module's documentation. Ordered: false with NaN, as `<=`.
-        Ma(unsafe { _mm256_cmp_ps::<_CMP_LE_OQ>(self.0, o.0) })
+        // Ordered: false with NaN, as `<=`.
+        self.cmp::<_CMP_LE_OQ>(o)
     }
     #[inline(always)]
     fn ne(self, o: Fa) -> Ma {
-        // SAFETY: see the module's documentation. Unordered: true with NaN, as `!=`.
-        Ma(unsafe { _mm256_cmp_ps::<_CMP_NEQ_UQ>(self.0, o.0) })
+        // Unordered: true with NaN, as `!=`.
+        self.cmp::<_CMP_NEQ_UQ>(o)
     }
     #[inline(always)]
     fn finite(self) -> Ma {
@@ -124,58 +166,84 @@ impl Lane for Fa {
     fn bits_eq(self, o: Fa) -> Ma {
         // SAFETY: see the module's documentation (`_mm256_cmpeq_epi32` is AVX2, which the
         // functions that use `Fa` enable). The casts only reinterpret the bits; equal
-        // 32-bit integers are equal `f32::to_bits`.
-        Ma(unsafe {
-            _mm256_castsi256_ps(_mm256_cmpeq_epi32(
-                _mm256_castps_si256(self.0),
-                _mm256_castps_si256(o.0),
-            ))
-        })
+        // 32-bit integers are equal `f32::to_bits`. (No closure: one is compiled without
+        // its caller's target features.)
+        unsafe {
+            Ma(
+                _mm256_castsi256_ps(_mm256_cmpeq_epi32(
+                    _mm256_castps_si256(self.0),
+                    _mm256_castps_si256(o.0),
+                )),
+                _mm256_castsi256_ps(_mm256_cmpeq_epi32(
+                    _mm256_castps_si256(self.1),
+                    _mm256_castps_si256(o.1),
+                )),
+            )
+        }
     }
     #[inline(always)]
     fn select(m: Ma, a: Fa, b: Fa) -> Fa {
         // SAFETY: see the module's documentation. `m` is all ones or all zeros per lane,
         // so the sign-bit blend picks whole lanes, as `F::select`'s bitwise choice.
-        Fa(unsafe { _mm256_blendv_ps(b.0, a.0, m.0) })
+        unsafe {
+            Fa(
+                _mm256_blendv_ps(b.0, a.0, m.0),
+                _mm256_blendv_ps(b.1, a.1, m.1),
+            )
+        }
     }
 }
 
 impl Mask for Ma {
     // All bits clear / all bits set, as `M`'s constants. SAFETY: any 32 bytes are a valid
     // `__m256`; the transmute only reinterprets the bits.
-    const NONE: Ma = Ma(unsafe { std::mem::transmute::<[u32; 8], __m256>([0; 8]) });
-    const ALL: Ma = Ma(unsafe { std::mem::transmute::<[u32; 8], __m256>([!0; 8]) });
+    const NONE: Ma = {
+        let h = unsafe { std::mem::transmute::<[u32; 8], __m256>([0; 8]) };
+        Ma(h, h)
+    };
+    const ALL: Ma = {
+        let h = unsafe { std::mem::transmute::<[u32; 8], __m256>([!0; 8]) };
+        Ma(h, h)
+    };
     #[inline(always)]
     fn and(self, o: Ma) -> Ma {
-        // SAFETY: see the module's documentation.
-        Ma(unsafe { _mm256_and_ps(self.0, o.0) })
+        let (lo, hi) = halves!(_mm256_and_ps, self, o);
+        Ma(lo, hi)
     }
     #[inline(always)]
     fn or(self, o: Ma) -> Ma {
-        // SAFETY: see the module's documentation.
-        Ma(unsafe { _mm256_or_ps(self.0, o.0) })
+        let (lo, hi) = halves!(_mm256_or_ps, self, o);
+        Ma(lo, hi)
     }
     #[inline(always)]
     fn not(self) -> Ma {
-        // SAFETY: see the module's documentation.
-        Ma(unsafe { _mm256_xor_ps(self.0, Ma::ALL.0) })
+        let (lo, hi) = halves!(_mm256_xor_ps, self, Ma::ALL);
+        Ma(lo, hi)
     }
     #[inline(always)]
     fn any(self) -> bool {
         // SAFETY: see the module's documentation. Lanes are all ones or all zeros, so a
         // lane is set exactly when its sign bit is.
-        unsafe { _mm256_movemask_ps(self.0) != 0 }
+        unsafe { _mm256_movemask_ps(_mm256_or_ps(self.0, self.1)) != 0 }
     }
     #[inline(always)]
     fn of(m: M) -> Ma {
-        // SAFETY: `M` is eight `u32` aligned to 32 bytes: an aligned load of their bits.
-        Ma(unsafe { _mm256_load_ps(m.0.as_ptr().cast::<f32>()) })
+        // SAFETY: `M` is sixteen `u32` aligned to 64 bytes: two aligned loads of its
+        // halves' bits.
+        unsafe {
+            let p = m.0.as_ptr().cast::<f32>();
+            Ma(_mm256_load_ps(p), _mm256_load_ps(p.add(8)))
+        }
     }
     #[inline(always)]
     fn m(self) -> M {
-        let mut m = M([0; 8]);
-        // SAFETY: an aligned store of the eight lanes' bits into `M` (32-byte aligned).
-        unsafe { _mm256_store_ps(m.0.as_mut_ptr().cast::<f32>(), self.0) };
+        let mut m = M([0; 16]);
+        // SAFETY: two aligned stores of the halves' bits into `M` (64-byte aligned).
+        unsafe {
+            let p = m.0.as_mut_ptr().cast::<f32>();
+            _mm256_store_ps(p, self.0);
+            _mm256_store_ps(p.add(8), self.1);
+        }
         m
     }
 }
@@ -218,7 +286,7 @@ mod tests {
         ];
         F(std::array::from_fn(|_| {
             let r = rng.next_u64();
-            if r % 4 == 0 {
+            if r.is_multiple_of(4) {
                 special[(r >> 8) as usize % special.len()]
             } else {
                 let x = (rng.next_u64() % 2_000_000) as f32 / 1000.0 - 1000.0;
@@ -271,6 +339,7 @@ mod tests {
                 assert_eq!(mx == Ma::ALL, ma == M::ALL);
                 assert_eq!(mx == Ma::NONE, ma == M::NONE);
                 assert_eq!(x.get(3).to_bits(), a.0[3].to_bits());
+                assert_eq!(x.get(12).to_bits(), a.0[12].to_bits());
             }
         });
     }

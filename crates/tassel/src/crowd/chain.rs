@@ -11,9 +11,11 @@
 
 #[cfg(target_arch = "x86_64")]
 use super::avx::Fa;
+#[cfg(target_arch = "x86_64")]
+use super::avx512::Fz;
 use super::chain_step::{output_lanes, step_lanes, Bound, LaneShape, LaneStep};
 use super::lanes::{rotation_arc, Lane, Mask, Trs, F, LANES, M, Q, V3};
-use super::CrowdPose;
+use super::{CrowdPose, Isa, SimdUse};
 use crate::collide::PlacedCollider;
 use crate::dynamics::chain::compile::{ChainRig, NONE, VIRTUAL};
 use crate::dynamics::chain::job::{
@@ -337,7 +339,7 @@ pub struct ChainCrowd {
     len: usize,
     scratch: Vec<Scratch>,
     shapes: Vec<LaneShape>,
-    avx2: bool,
+    simd: SimdUse,
 }
 
 impl ChainCrowd {
@@ -362,13 +364,13 @@ impl ChainCrowd {
             len: 0,
             scratch: Vec::new(),
             shapes,
-            avx2: true,
+            simd: SimdUse::Auto,
         })
     }
 
     /// Adds a character; returns its index. It starts from its pose on its first frame.
     pub fn add(&mut self) -> usize {
-        if self.len % LANES == 0 {
+        if self.len.is_multiple_of(LANES) {
             self.packs.push(Pack::new(&self.rig));
         }
         let i = self.len;
@@ -397,11 +399,14 @@ impl ChainCrowd {
         Ok(())
     }
 
-    /// Allows (the default) or forbids the AVX2 code path on CPUs that have it. The results
-    /// are the same bits either way; forbidding it is for measuring and testing the
-    /// baseline (SSE2) path.
-    pub fn set_avx2(&mut self, allow: bool) {
-        self.avx2 = allow;
+    /// Which lane code steps the crowd: the widest the CPU has ([`SimdUse::Auto`], the
+    /// default: AVX-512, else AVX2, else portable), AVX2 at most ([`SimdUse::Avx2`]) or
+    /// the portable code ([`SimdUse::Portable`]; the crowd has no scalar code of its own,
+    /// so [`SimdUse::Scalar`] runs that too: its scalar reference is
+    /// [`crate::CharacterSim`]). The results are the same bits whichever runs; the
+    /// choice is for measuring and testing each.
+    pub fn set_simd(&mut self, simd: SimdUse) {
+        self.simd = simd;
     }
 
     /// Number of characters.
@@ -525,7 +530,7 @@ impl ChainCrowd {
             rig: &self.rig,
             shapes: &self.shapes,
             dt,
-            avx2: self.avx2,
+            isa: Isa::of(self.simd),
         };
         let input = &input;
         self.packs
@@ -555,8 +560,8 @@ pub(crate) struct LaneFrame {
     pub component: Transform,
     /// Frame time, seconds.
     pub dt: f32,
-    /// Whether AVX2 may be used (where the CPU has it).
-    pub avx2: bool,
+    /// The lane code that runs it.
+    pub isa: Isa,
 }
 
 /// The lanes of [`super::chain_lanes`]: a lane group whose "characters" are twin chains of
@@ -701,7 +706,7 @@ impl Twins {
             rig,
             shapes,
             dt: frame.dt,
-            avx2: frame.avx2,
+            isa: frame.isa,
         }
         .step(pack, s, false);
         for (l, start) in starts.enumerate() {
@@ -719,7 +724,7 @@ struct Ctx<'c> {
     /// Each rig collider's shape as the lanes see it.
     shapes: &'c [LaneShape],
     dt: f32,
-    avx2: bool,
+    isa: Isa,
 }
 
 /// The per-lane inputs of a step that depend on where each character is: its motion since
@@ -1000,7 +1005,6 @@ fn model_pose_lanes<T: Lane>(
     let mut bad = <T::M as Mask>::NONE;
     let mut sure = <T::M as Mask>::ALL;
     let max = T::splat(crate::limits::MAX_COORDINATE);
-    let within = |v: V3<T>| v.x.le(max).and(v.y.le(max)).and(v.z.le(max));
     for j in 0..n {
         let mut local = root;
         for l in 0..count {
@@ -1012,7 +1016,7 @@ fn model_pose_lanes<T: Lane>(
         let unit = (local.r.dot(local.r) - T::splat(1.0))
             .abs()
             .le(T::splat(0.2));
-        sure = sure.and(unit).and(within(t)).and(within(sc));
+        sure = sure.and(unit).and(within(t, max)).and(within(sc, max));
         let model = match sk.parent(j) {
             Some(p) => Trs::<T>::of(&s.lane_models[p]).mul(&local),
             None => Trs::<T>::splat(&Transform::IDENTITY).mul(&local),
@@ -1026,6 +1030,13 @@ fn model_pose_lanes<T: Lane>(
         s.lane_models[j] = model.f();
     }
     (bad.m(), sure.not().m())
+}
+
+/// Every coordinate of `v` at most `max`, per lane. (A function, not a closure: see
+/// `chain_step::select_max`.)
+#[inline(always)]
+fn within<T: Lane>(v: V3<T>, max: T) -> T::M {
+    v.x.le(max).and(v.y.le(max)).and(v.z.le(max))
 }
 
 /// `gather_targets`' animated targets and planar normals per point (the normals of chains
@@ -1135,18 +1146,16 @@ impl Ctx<'_> {
     /// [`Ctx::step`]): the lanes with a non-finite model transform, and the lanes whose
     /// locals the lanes could not vouch for (as `model_pose_lanes`).
     fn model_pose(&self, locals: &[&[Transform]; LANES], s: &mut Scratch, count: usize) -> (M, M) {
+        // SAFETY (both): the function only requires the instructions of its lane type,
+        // and `Isa::of` chose that type because the CPU has them.
         #[cfg(target_arch = "x86_64")]
-        if self.avx2 && std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: `model_pose_avx2` only requires the AVX2 instructions, and the CPU
-            // was just checked to have them.
-            #[allow(unsafe_code)]
-            unsafe {
-                return self.model_pose_avx2(locals, s, count);
-            }
+        #[allow(unsafe_code)]
+        match self.isa {
+            Isa::Avx512 => return unsafe { self.model_pose_avx512(locals, s, count) },
+            Isa::Avx2 => return unsafe { self.model_pose_avx2(locals, s, count) },
+            Isa::Portable => {}
         }
-        let bad = model_pose_lanes::<F>(self.sk, locals, s, count);
-        targets_lanes::<F>(self.sk, self.rig, s);
-        bad
+        self.model_pose_in::<F>(locals, s, count)
     }
 
     #[cfg(target_arch = "x86_64")]
@@ -1157,27 +1166,49 @@ impl Ctx<'_> {
         s: &mut Scratch,
         count: usize,
     ) -> (M, M) {
-        // The explicit AVX lane type, only here after the CPU was found to have AVX2.
-        let bad = model_pose_lanes::<Fa>(self.sk, locals, s, count);
-        targets_lanes::<Fa>(self.sk, self.rig, s);
+        // The explicit AVX2 lane type, only here after the CPU was found to have AVX2.
+        self.model_pose_in::<Fa>(locals, s, count)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f,avx512dq,avx512vl,avx512bw")]
+    fn model_pose_avx512(
+        &self,
+        locals: &[&[Transform]; LANES],
+        s: &mut Scratch,
+        count: usize,
+    ) -> (M, M) {
+        // The explicit AVX-512 lane type, only here after the CPU was found to have it.
+        self.model_pose_in::<Fz>(locals, s, count)
+    }
+
+    #[inline(always)]
+    fn model_pose_in<T: Lane>(
+        &self,
+        locals: &[&[Transform]; LANES],
+        s: &mut Scratch,
+        count: usize,
+    ) -> (M, M) {
+        let bad = model_pose_lanes::<T>(self.sk, locals, s, count);
+        targets_lanes::<T>(self.sk, self.rig, s);
         bad
     }
 
-    /// One frame of one lane group whose input is in `s`: with AVX2 where the CPU has it
-    /// (the steps in the explicit AVX lane type, `crowd/avx.rs`), else over `F` with the
-    /// baseline SSE2. Every lane operation of both is IEEE-exact, so both give the same
-    /// bits.
+    /// One frame of one lane group whose input is in `s`, in the lane type `self.isa`
+    /// chose (the explicit AVX-512 or AVX2 type, `crowd/avx512.rs`, `crowd/avx.rs`, else
+    /// [`F`] with the baseline SSE2). Every lane operation of each is IEEE-exact, so all
+    /// give the same bits.
     /// `write_back`: also the rotators' rotations per lane (a crowd's characters; twin
     /// chains have their own write-back).
     fn step(&self, pack: &mut Pack, s: &mut Scratch, write_back: bool) {
+        // SAFETY (both): the function only requires the instructions of its lane type,
+        // and `Isa::of` chose that type because the CPU has them.
         #[cfg(target_arch = "x86_64")]
-        if self.avx2 && std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: `step_avx2` only requires the AVX2 instructions, and the CPU was
-            // just checked to have them.
-            #[allow(unsafe_code)]
-            unsafe {
-                return self.step_avx2(pack, s, write_back);
-            }
+        #[allow(unsafe_code)]
+        match self.isa {
+            Isa::Avx512 => return unsafe { self.step_avx512(pack, s, write_back) },
+            Isa::Avx2 => return unsafe { self.step_avx2(pack, s, write_back) },
+            Isa::Portable => {}
         }
         self.step_lanes::<F>(pack, s, write_back)
     }
@@ -1185,8 +1216,15 @@ impl Ctx<'_> {
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
     fn step_avx2(&self, pack: &mut Pack, s: &mut Scratch, write_back: bool) {
-        // The explicit AVX lane type, only here after the CPU was found to have AVX2.
+        // The explicit AVX2 lane type, only here after the CPU was found to have AVX2.
         self.step_lanes::<Fa>(pack, s, write_back)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f,avx512dq,avx512vl,avx512bw")]
+    fn step_avx512(&self, pack: &mut Pack, s: &mut Scratch, write_back: bool) {
+        // The explicit AVX-512 lane type, only here after the CPU was found to have it.
+        self.step_lanes::<Fz>(pack, s, write_back)
     }
 
     /// One frame of one lane group whose input is in `scratch`; the solver steps

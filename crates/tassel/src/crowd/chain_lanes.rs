@@ -16,6 +16,7 @@ pub(crate) use super::chain::LaneFrame;
 use super::chain::Twins;
 use super::chain_step::LaneShape;
 use super::lanes::{rotation_arc, Lane, Mask, F, LANES, M, Q, V3};
+use super::Isa;
 use crate::collide::PlacedCollider;
 use crate::dynamics::chain::compile::{ChainRig, CompiledChain, NONE};
 use crate::dynamics::path::CharacterPath;
@@ -358,20 +359,25 @@ impl ChainLanes {
         locals: &mut [Transform],
         models: &mut [Transform],
         turned: &mut Vec<TurnedRow>,
-        avx2: bool,
+        isa: Isa,
     ) {
         let Some(rotators) = &group.write_back else {
             return;
         };
+        // SAFETY (both): the function only requires the instructions of its lane type,
+        // and `Isa::of` chose that type because the CPU has them.
         #[cfg(target_arch = "x86_64")]
-        if avx2 && std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: `write_back_avx2` only requires the AVX2 instructions, and the CPU
-            // was just checked to have them.
-            #[allow(unsafe_code)]
-            unsafe {
-                return self.write_back_avx2(group, rotators, locals, models, turned);
+        #[allow(unsafe_code)]
+        match isa {
+            Isa::Avx512 => {
+                return unsafe { self.write_back_avx512(group, rotators, locals, models, turned) }
             }
+            Isa::Avx2 => {
+                return unsafe { self.write_back_avx2(group, rotators, locals, models, turned) }
+            }
+            Isa::Portable => {}
         }
+        let _ = isa;
         self.write_back_lanes::<F>(group, rotators, locals, models, turned)
     }
 
@@ -385,8 +391,22 @@ impl ChainLanes {
         models: &mut [Transform],
         turned: &mut Vec<TurnedRow>,
     ) {
-        // The explicit AVX lane type, only here after the CPU was found to have AVX2.
+        // The explicit AVX2 lane type, only here after the CPU was found to have AVX2.
         self.write_back_lanes::<super::avx::Fa>(group, rotators, locals, models, turned)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f,avx512dq,avx512vl,avx512bw")]
+    fn write_back_avx512(
+        &self,
+        group: &ChainLaneGroup,
+        rotators: &[LaneRotator],
+        locals: &mut [Transform],
+        models: &mut [Transform],
+        turned: &mut Vec<TurnedRow>,
+    ) {
+        // The explicit AVX-512 lane type, only here after the CPU was found to have it.
+        self.write_back_lanes::<super::avx512::Fz>(group, rotators, locals, models, turned)
     }
 
     /// [`ChainLanes::write_back`] computed in the lane type `T`.

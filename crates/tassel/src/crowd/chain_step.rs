@@ -362,14 +362,25 @@ pub(super) fn entry_possible<T: Lane>(
 ) -> T::M {
     let lb = (prev_dist + d.length() - (p - prev).length()) * T::splat(0.5);
     // The largest coordinate's size (a NaN gives a NaN bound: possible).
-    let max = |x: T, y: T| T::select(x.gt(y), x, y);
-    let big = |v: V3<T>| {
-        let v = v.abs();
-        max(max(v.x, v.y), v.z)
-    };
+    let (big, max) = (largest_size::<T>, select_max::<T>);
     let m = max(max(big(p), big(prev)), max(big(a), big(b)));
     let bound = inner + T::splat(1e-5) * (m + inner + T::splat(1.0));
     inner.le(prev_dist).and(lb.gt(bound).not())
+}
+
+/// `x > y ? x : y` per lane. (Functions, not closures: a closure is compiled without
+/// its caller's target features, so the lane types' intrinsics are not inlined into it
+/// when it is not inlined itself.)
+#[inline(always)]
+fn select_max<T: Lane>(x: T, y: T) -> T {
+    T::select(x.gt(y), x, y)
+}
+
+/// The largest coordinate's size per lane.
+#[inline(always)]
+fn largest_size<T: Lane>(v: V3<T>) -> T {
+    let v = v.abs();
+    select_max(select_max(v.x, v.y), v.z)
 }
 
 /// Everything one lane step reads besides the rig and the points (as
@@ -603,7 +614,6 @@ pub(super) fn step_lanes<T: Lane>(
     let exponent = s.target_framerate * input.dt;
     let active = <T::M as Mask>::of(input.active);
     let dt = T::splat(input.dt);
-    let t = |p: usize| V3::<T>::of(input.targets[p]);
     let list = &chain.colliders;
     let dt_old = T::of(input.dt_old);
     let has_velocity = dt_old.gt(T::splat(0.0));
@@ -616,8 +626,9 @@ pub(super) fn step_lanes<T: Lane>(
         let parent = rig.parent[p];
         let (pos_p, prev_p) = (V3::<T>::of(pos[p]), V3::<T>::of(prev[p]));
         if parent == NONE {
-            pos[p] = V3::select(active, t(p), pos_p).f();
-            prev[p] = V3::select(active, t(p), prev_p).f();
+            let t = V3::<T>::of(input.targets[p]);
+            pos[p] = V3::select(active, t, pos_p).f();
+            prev[p] = V3::select(active, t, prev_p).f();
             continue;
         }
         let pp = parent as usize;
@@ -646,7 +657,7 @@ pub(super) fn step_lanes<T: Lane>(
         x = x + gravity_step;
 
         let parent_pos = V3::<T>::of(pos[pp]);
-        let (tp, tpp) = (t(p), t(pp));
+        let (tp, tpp) = (V3::<T>::of(input.targets[p]), V3::of(input.targets[pp]));
         let base = parent_pos + (tp - tpp);
         x = x + (base - x) * T::splat(pull(rig.stiffness[p], exponent));
 
@@ -1064,15 +1075,26 @@ mod tests {
                 (sphere_entry(p, q, c, F::splat(limit), &contact), M::NONE)
             };
             #[cfg(target_arch = "x86_64")]
-            if std::is_x86_feature_detected!("avx2") {
-                // SAFETY: the CPU has AVX2 (checked just above).
-                #[allow(unsafe_code)]
-                let avx = unsafe { contact_avx2(capsule, p, q, a, b, c, limit) };
-                assert_eq!(avx.0, may, "round {round}: AVX decision");
-                assert_eq!(avx.1, entered, "round {round}: AVX entry");
-                assert_eq!(bits(avx.2), bits(pushed), "round {round}: AVX push");
-                assert_eq!(bits(avx.3), bits(entry), "round {round}: AVX entry point");
-                assert_eq!(avx.4, hard, "round {round}: AVX hard entries");
+            {
+                use crate::crowd::{Isa, SimdUse};
+                let mut explicit = Vec::new();
+                if Isa::of(SimdUse::Avx2) == Isa::Avx2 {
+                    // SAFETY: the CPU has AVX2 (checked just above).
+                    #[allow(unsafe_code)]
+                    explicit.push(unsafe { contact_avx2(capsule, p, q, a, b, c, limit) });
+                }
+                if Isa::of(SimdUse::Auto) == Isa::Avx512 {
+                    // SAFETY: the CPU has AVX-512 (checked just above).
+                    #[allow(unsafe_code)]
+                    explicit.push(unsafe { contact_avx512(capsule, p, q, a, b, c, limit) });
+                }
+                for avx in explicit {
+                    assert_eq!(avx.0, may, "round {round}: AVX decision");
+                    assert_eq!(avx.1, entered, "round {round}: AVX entry");
+                    assert_eq!(bits(avx.2), bits(pushed), "round {round}: AVX push");
+                    assert_eq!(bits(avx.3), bits(entry), "round {round}: AVX entry point");
+                    assert_eq!(avx.4, hard, "round {round}: AVX hard entries");
+                }
             }
             for l in 0..LANES {
                 let want = if capsule {
@@ -1130,7 +1152,7 @@ mod tests {
         );
     }
 
-    /// [`capsule_contact`] or [`sphere_contact`] in the AVX lane type, back in `F`/`M`.
+    /// [`capsule_contact`] or [`sphere_contact`] in the AVX2 lane type, back in `F`/`M`.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
     #[allow(clippy::too_many_arguments)]
@@ -1143,15 +1165,45 @@ mod tests {
         c: V3,
         limit: f32,
     ) -> (M, M, V3, V3, M) {
-        use crate::crowd::avx::Fa;
-        let (p, q) = (V3::<Fa>::of(p), V3::<Fa>::of(q));
-        let (a, b, c, limit) = (V3::of(a), V3::of(b), V3::of(c), Fa::splat(limit));
+        contact_in::<crate::crowd::avx::Fa>(capsule, p, q, a, b, c, limit)
+    }
+
+    /// [`capsule_contact`] or [`sphere_contact`] in the AVX-512 lane type, back in
+    /// `F`/`M`.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f,avx512dq,avx512vl,avx512bw")]
+    #[allow(clippy::too_many_arguments)]
+    fn contact_avx512(
+        capsule: bool,
+        p: V3,
+        q: V3,
+        a: V3,
+        b: V3,
+        c: V3,
+        limit: f32,
+    ) -> (M, M, V3, V3, M) {
+        contact_in::<crate::crowd::avx512::Fz>(capsule, p, q, a, b, c, limit)
+    }
+
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn contact_in<T: Lane>(
+        capsule: bool,
+        p: V3,
+        q: V3,
+        a: V3,
+        b: V3,
+        c: V3,
+        limit: f32,
+    ) -> (M, M, V3, V3, M) {
+        let (p, q) = (V3::<T>::of(p), V3::<T>::of(q));
+        let (a, b, c, limit) = (V3::of(a), V3::of(b), V3::of(c), T::splat(limit));
         let (k, (entry, hard)) = if capsule {
             let k = capsule_contact(p, q, a, b, limit);
             (k, capsule_entry_push(p, q, a, b, limit, &k))
         } else {
             let k = sphere_contact(p, q, c, limit);
-            (k, (sphere_entry(p, q, c, limit, &k), <Fa as Lane>::M::NONE))
+            (k, (sphere_entry(p, q, c, limit, &k), <T::M as Mask>::NONE))
         };
         (
             k.may.m(),

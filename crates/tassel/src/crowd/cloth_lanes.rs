@@ -34,6 +34,9 @@ use glam::Vec3;
 
 #[cfg(target_arch = "x86_64")]
 use super::avx::Fa;
+#[cfg(target_arch = "x86_64")]
+use super::avx512::Fz;
+use super::Isa;
 
 /// What one contact pass keeps between its look-ahead and its walk. Lives in the cloth
 /// state; sized on first use, so a frame allocates nothing.
@@ -52,11 +55,10 @@ pub(crate) struct ClothLaneScratch {
     sides: Vec<i8>,
 }
 
-/// The cloth job's `collide`, computed with lanes: AVX2 where `avx2` allows it and the
-/// CPU has it, else the portable lane type. The same arguments and results, bit for bit.
+/// The cloth job's `collide`, computed with lanes in the lane type `isa` chose. The same arguments and results, bit for bit.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn collide(
-    avx2: bool,
+    isa: Isa,
     rig: &ClothRig,
     ci: usize,
     colliders: &[PlacedCollider],
@@ -78,42 +80,41 @@ pub(crate) fn collide(
         cores,
         scratch,
     };
+    // SAFETY (both): the function only requires the instructions of its lane type, and
+    // `Isa::of` chose that type because the CPU has them.
     #[cfg(target_arch = "x86_64")]
-    if avx2 && std::arch::is_x86_feature_detected!("avx2") {
-        // SAFETY: `run_avx2` only requires the AVX2 instructions, and the CPU was just
-        // checked to have them.
-        #[allow(unsafe_code)]
-        unsafe {
-            return pass.run_avx2();
-        }
+    #[allow(unsafe_code)]
+    match isa {
+        Isa::Avx512 => return unsafe { pass.run_avx512() },
+        Isa::Avx2 => return unsafe { pass.run_avx2() },
+        Isa::Portable => {}
     }
-    let _ = avx2;
+    let _ = isa;
     pass.run::<F>()
 }
 
 /// The cloth job's `limit_angles`, one chain per lane, [`LANES`] chains side by side
-/// going down their points together: AVX2 where `avx2` allows it and the CPU has it,
-/// else the portable lane type. The lanes compute each segment's angle to its expected
+/// going down their points together, in the lane type `isa` chose. The lanes compute each segment's angle to its expected
 /// direction and, for a segment past the limit, its turn back (the scalar operations, so
 /// the same bits). A chain's points are its own, so chains side by side give what one
 /// after another gives.
 pub(crate) fn limit_angles(
-    avx2: bool,
+    isa: Isa,
     rig: &ClothRig,
     ci: usize,
     targets: &[Vec3],
     pos: &mut [Vec3],
 ) {
+    // SAFETY (both): the function only requires the instructions of its lane type, and
+    // `Isa::of` chose that type because the CPU has them.
     #[cfg(target_arch = "x86_64")]
-    if avx2 && std::arch::is_x86_feature_detected!("avx2") {
-        // SAFETY: `limit_angles_avx2` only requires the AVX2 instructions, and the CPU
-        // was just checked to have them.
-        #[allow(unsafe_code)]
-        unsafe {
-            return limit_angles_avx2(rig, ci, targets, pos);
-        }
+    #[allow(unsafe_code)]
+    match isa {
+        Isa::Avx512 => return unsafe { limit_angles_avx512(rig, ci, targets, pos) },
+        Isa::Avx2 => return unsafe { limit_angles_avx2(rig, ci, targets, pos) },
+        Isa::Portable => {}
     }
-    let _ = avx2;
+    let _ = isa;
     limit_angles_in::<F>(rig, ci, targets, pos)
 }
 
@@ -123,12 +124,20 @@ fn limit_angles_avx2(rig: &ClothRig, ci: usize, targets: &[Vec3], pos: &mut [Vec
     limit_angles_in::<Fa>(rig, ci, targets, pos)
 }
 
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512dq,avx512vl,avx512bw")]
+fn limit_angles_avx512(rig: &ClothRig, ci: usize, targets: &[Vec3], pos: &mut [Vec3]) {
+    limit_angles_in::<Fz>(rig, ci, targets, pos)
+}
+
 #[inline(always)]
 fn limit_angles_in<T: Lane>(rig: &ClothRig, ci: usize, targets: &[Vec3], pos: &mut [Vec3]) {
     let cloth = &rig.cloths[ci];
     let limit = cloth.settings.limit_angle.to_radians();
     for group in cloth.chains.chunks(LANES) {
         // Point `k` of each chain of the group (lanes past a chain's end left at zero).
+        // (In `F`: the conversion to `T` is left to the caller, a closure being compiled
+        // without its caller's target features: see `chain_step::select_max`.)
         let gather = |k: usize, from: &[Vec3]| {
             let mut v = V3::ZERO;
             for (l, ch) in group.iter().enumerate() {
@@ -136,13 +145,14 @@ fn limit_angles_in<T: Lane>(rig: &ClothRig, ci: usize, targets: &[Vec3], pos: &m
                     v.set(l, from[ch.start + k]);
                 }
             }
-            V3::<T>::of(v)
+            v
         };
         let longest = group.iter().map(|ch| ch.len()).max().unwrap_or(0);
-        let (mut t_parent, mut p_parent) = (gather(0, targets), gather(0, pos));
+        let (mut t_parent, mut p_parent) =
+            (V3::<T>::of(gather(0, targets)), V3::<T>::of(gather(0, pos)));
         let (mut t_grand, mut p_grand) = (t_parent, p_parent);
         for k in 1..longest {
-            let (t, mut p) = (gather(k, targets), gather(k, pos));
+            let (t, mut p) = (V3::<T>::of(gather(k, targets)), V3::<T>::of(gather(k, pos)));
             let anim = t - t_parent;
             let expected = if k > 1 {
                 rotation_arc(t_parent - t_grand, p_parent - p_grand).mul_vec3(anim)
@@ -228,8 +238,15 @@ impl Pass<'_> {
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
     fn run_avx2(&mut self) -> bool {
-        // The explicit AVX lane type, only here after the CPU was found to have AVX2.
+        // The explicit AVX2 lane type, only here after the CPU was found to have AVX2.
         self.run::<Fa>()
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f,avx512dq,avx512vl,avx512bw")]
+    fn run_avx512(&mut self) -> bool {
+        // The explicit AVX-512 lane type, only here after the CPU was found to have it.
+        self.run::<Fz>()
     }
 
     /// The scalar `collide`'s passes in its order: points, segments, triangles.
@@ -731,15 +748,13 @@ fn closest_point_on_triangle<T: Lane>(p: V3<T>, a: V3<T>, b: V3<T>, c: V3<T>) ->
     let bp = p - b;
     let d3 = ab.dot(bp);
     let d4 = ac.dot(bp);
-    let mut take = |m: T::M, v: V3<T>, out: &mut V3<T>| {
-        let m = m.and(done.not());
-        *out = V3::select(m, v, *out);
-        done = done.or(m);
-    };
-    take(zero.le(d3).and(d4.le(d3)), b, &mut out);
+    // (A function, not a closure: see `chain_step::select_max`.)
+    let take = take_where_open::<T>;
+    take(&mut done, zero.le(d3).and(d4.le(d3)), b, &mut out);
     let vc = d1 * d4 - d3 * d2;
     let v = d1 / (d1 - d3);
     take(
+        &mut done,
         vc.le(zero).and(zero.le(d1)).and(d3.le(zero)),
         a + ab * v,
         &mut out,
@@ -747,10 +762,11 @@ fn closest_point_on_triangle<T: Lane>(p: V3<T>, a: V3<T>, b: V3<T>, c: V3<T>) ->
     let cp = p - c;
     let d5 = ab.dot(cp);
     let d6 = ac.dot(cp);
-    take(zero.le(d6).and(d5.le(d6)), c, &mut out);
+    take(&mut done, zero.le(d6).and(d5.le(d6)), c, &mut out);
     let vb = d5 * d2 - d1 * d6;
     let w = d2 / (d2 - d6);
     take(
+        &mut done,
         vb.le(zero).and(zero.le(d2)).and(d6.le(zero)),
         a + ac * w,
         &mut out,
@@ -759,16 +775,30 @@ fn closest_point_on_triangle<T: Lane>(p: V3<T>, a: V3<T>, b: V3<T>, c: V3<T>) ->
     let (d43, d56) = (d4 - d3, d5 - d6);
     let w = d43 / (d43 + d56);
     take(
+        &mut done,
         va.le(zero).and(zero.le(d43)).and(zero.le(d56)),
         b + (c - b) * w,
         &mut out,
     );
     let denom = va + vb + vc;
-    take(denom.abs().lt(T::splat(1e-30)), a, &mut out);
+    take(&mut done, denom.abs().lt(T::splat(1e-30)), a, &mut out);
     let v = vb / denom;
     let w = vc / denom;
-    take(<T::M as Mask>::ALL, a + ab * v + ac * w, &mut out);
+    take(
+        &mut done,
+        <T::M as Mask>::ALL,
+        a + ab * v + ac * w,
+        &mut out,
+    );
     out
+}
+
+/// `out` takes `v` in the lanes of `m` not `done` yet, which are then done.
+#[inline(always)]
+fn take_where_open<T: Lane>(done: &mut T::M, m: T::M, v: V3<T>, out: &mut V3<T>) {
+    let m = m.and(done.not());
+    *out = V3::select(m, v, *out);
+    *done = done.or(m);
 }
 
 #[cfg(test)]

@@ -15,8 +15,6 @@
 //! few `f32` operations) is inlined where it is asked: out of line, the call and its
 //! arguments' trip through memory cost one character about 2 %.
 
-#[cfg(target_arch = "x86_64")]
-use super::avx::Fa;
 use super::chain_step::{entry_radius_lanes, LaneContact};
 use super::lanes::{closest_point_on_segment, Lane, F, LANES};
 use super::lanes::{Mask, M, V3};
@@ -335,13 +333,21 @@ pub(super) fn capsule_entry_out_of_line<T: Lane>(
         contact.f(),
         need.m(),
     );
+    // SAFETY (both): a value of an explicit lane type exists only inside functions
+    // compiled with its instructions after the CPU was found to have them
+    // (`crowd/avx.rs`, `crowd/avx512.rs`), so the CPU has them.
     #[cfg(target_arch = "x86_64")]
-    if T::AVX {
-        // SAFETY: a value of the AVX lane type exists only inside functions compiled with
-        // AVX2 after the CPU was found to have it (`crowd/avx.rs`), so the CPU has AVX2.
-        #[allow(unsafe_code)]
-        let (e, h) = unsafe { entry_avx2(args) };
-        return (V3::of(e), <T::M as Mask>::of(h));
+    #[allow(unsafe_code)]
+    match T::ISA {
+        super::Isa::Avx512 => {
+            let (e, h) = unsafe { entry_avx512(args) };
+            return (V3::of(e), <T::M as Mask>::of(h));
+        }
+        super::Isa::Avx2 => {
+            let (e, h) = unsafe { entry_avx2(args) };
+            return (V3::of(e), <T::M as Mask>::of(h));
+        }
+        super::Isa::Portable => {}
     }
     let (e, h) = entry_portable(args);
     (V3::of(e), <T::M as Mask>::of(h))
@@ -359,7 +365,14 @@ fn entry_portable(args: EntryArgs) -> (V3, M) {
 #[target_feature(enable = "avx2")]
 #[inline(never)]
 fn entry_avx2(args: EntryArgs) -> (V3, M) {
-    entry_in::<Fa>(args)
+    entry_in::<super::avx::Fa>(args)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512dq,avx512vl,avx512bw")]
+#[inline(never)]
+fn entry_avx512(args: EntryArgs) -> (V3, M) {
+    entry_in::<super::avx512::Fz>(args)
 }
 
 #[inline(always)]

@@ -16,17 +16,29 @@ use crate::math::Transform;
 use glam::{Quat, Vec3};
 use std::ops::{Add, Div, Mul, Neg, Sub};
 
-/// Characters per lane group.
+/// Characters per lane group: 16 on x86_64, where one AVX-512 register holds them (a CPU
+/// with AVX2 only takes them in two registers, `crowd/avx.rs`), 8 elsewhere (the
+/// portable lane type over arrays, which the compiler splits into the target's vectors:
+/// sixteen would need more registers than SSE or NEON have, measured 1.4x slower on
+/// x86_64 without AVX).
+#[cfg(target_arch = "x86_64")]
+pub const LANES: usize = 16;
+/// Characters per lane group: 16 on x86_64, where one AVX-512 register holds them (a CPU
+/// with AVX2 only takes them in two registers, `crowd/avx.rs`), 8 elsewhere (the
+/// portable lane type over arrays, which the compiler splits into the target's vectors:
+/// sixteen would need more registers than SSE or NEON have, measured 1.4x slower on
+/// x86_64 without AVX).
+#[cfg(not(target_arch = "x86_64"))]
 pub const LANES: usize = 8;
 
 /// One `f32` per lane.
 #[derive(Clone, Copy, Debug, PartialEq)]
-#[repr(C, align(32))]
+#[repr(C, align(64))]
 pub struct F(pub [f32; LANES]);
 
 /// A per-lane condition (all bits set when true).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[repr(C, align(32))]
+#[repr(C, align(64))]
 pub struct M(pub [u32; LANES]);
 
 macro_rules! lanewise {
@@ -227,9 +239,9 @@ pub trait Lane:
 {
     /// The per-lane condition of this type.
     type M: Mask;
-    /// Whether this is the AVX lane type (whose values exist only inside functions
-    /// compiled with AVX2, after the CPU was found to have it).
-    const AVX: bool = false;
+    /// Which instructions this type's values need (an explicit type's exist only inside
+    /// functions compiled with them, after the CPU was found to have them).
+    const ISA: super::Isa = super::Isa::Portable;
     /// Every lane `v`.
     fn splat(v: f32) -> Self;
     /// From [`F`] (the same lanes).
@@ -637,12 +649,12 @@ impl<T: Lane> Q<T> {
         let tx = [l.x * r.w, -(l.x * r.z), l.x * r.y, -(l.x * r.x)];
         let ty = [l.y * r.z, l.y * r.w, -(l.y * r.x), -(l.y * r.y)];
         let tz = [-(l.z * r.y), l.z * r.x, l.z * r.w, -(l.z * r.z)];
-        let c = |k: usize| (tw[k] + tx[k]) + (ty[k] + tz[k]);
+        // (No closure: one is compiled without its caller's target features.)
         Q {
-            x: c(0),
-            y: c(1),
-            z: c(2),
-            w: c(3),
+            x: (tw[0] + tx[0]) + (ty[0] + tz[0]),
+            y: (tw[1] + tx[1]) + (ty[1] + tz[1]),
+            z: (tw[2] + tx[2]) + (ty[2] + tz[2]),
+            w: (tw[3] + tx[3]) + (ty[3] + tz[3]),
         }
     }
 
@@ -1024,10 +1036,17 @@ pub(crate) fn turned_toward<T: Lane>(
 /// only for -0 and NaN. Rounding -0 with either sign of 2²³ gives +0; a NaN rounds to
 /// itself either way; and the reflection never takes π's sign for -0 (|-0| ≤ π/2) and
 /// gives the NaN for a NaN (`π − NaN`).
+/// `x < 0` per lane.
+#[inline(always)]
+fn is_negative<T: Lane>(x: T) -> T::M {
+    x.lt(T::splat(0.0))
+}
+
 #[inline(always)]
 fn sin_approx<T: Lane>(v: T) -> T {
     let c = T::splat;
-    let negative = |x: T| x.lt(c(0.0));
+    // (A function, not a closure: see `chain_step::select_max`.)
+    let negative = is_negative::<T>;
     // m128_mod_angles: v − 2π·round(v / 2π), rounding by the 2^23 trick.
     let q = v * c(0.159_154_94);
     let magic = T::select(negative(q), c(-8_388_608.0), c(8_388_608.0));
@@ -1136,24 +1155,26 @@ impl<T: Lane> V3<T> {
 }
 
 /// `out[k] = a[k].lerp(&b[k], t)` for every `k` in `joints` ([`Transform::lerp`]'s bits),
-/// eight at a time, compiled for AVX2 where `avx2` allows it and the CPU has it.
+/// [`LANES`] at a time, in the lane type `isa` chose.
 pub(crate) fn lerp_transforms_at(
     a: &[Transform],
     b: &[Transform],
     t: f32,
     joints: &[usize],
     out: &mut [Transform],
-    avx2: bool,
+    isa: super::Isa,
 ) {
+    use super::Isa;
+    // SAFETY (both): the function only requires the instructions of its lane type, and
+    // `Isa::of` chose that type because the CPU has them.
     #[cfg(target_arch = "x86_64")]
-    if avx2 && std::arch::is_x86_feature_detected!("avx2") {
-        // SAFETY: the function only requires AVX2, which the CPU was just found to have.
-        #[allow(unsafe_code)]
-        unsafe {
-            return lerp_transforms_at_avx2(a, b, t, joints, out);
-        }
+    #[allow(unsafe_code)]
+    match isa {
+        Isa::Avx512 => return unsafe { lerp_transforms_at_avx512(a, b, t, joints, out) },
+        Isa::Avx2 => return unsafe { lerp_transforms_at_avx2(a, b, t, joints, out) },
+        Isa::Portable => {}
     }
-    let _ = avx2;
+    let _ = isa;
     lerp_transforms_at_lanes::<F>(a, b, t, joints, out)
 }
 
@@ -1166,9 +1187,23 @@ fn lerp_transforms_at_avx2(
     joints: &[usize],
     out: &mut [Transform],
 ) {
-    // The explicit AVX lane type only inside this function, after the CPU was found to
+    // The explicit AVX2 lane type only inside this function, after the CPU was found to
     // have AVX2 (the condition of its soundness, `crowd/avx.rs`).
     lerp_transforms_at_lanes::<super::avx::Fa>(a, b, t, joints, out)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512dq,avx512vl,avx512bw")]
+fn lerp_transforms_at_avx512(
+    a: &[Transform],
+    b: &[Transform],
+    t: f32,
+    joints: &[usize],
+    out: &mut [Transform],
+) {
+    // The explicit AVX-512 lane type only inside this function, after the CPU was found
+    // to have it (the condition of its soundness, `crowd/avx512.rs`).
+    lerp_transforms_at_lanes::<super::avx512::Fz>(a, b, t, joints, out)
 }
 
 #[inline(always)]

@@ -22,8 +22,11 @@
 
 #[cfg(target_arch = "x86_64")]
 use super::avx::Fa;
+#[cfg(target_arch = "x86_64")]
+use super::avx512::Fz;
 use super::lanes::{rotation_arc_from_lanes, Lane, Mask, Trs, F, LANES, M, Q, V3};
 use super::vrm_contact::{collide_tail, Placed};
+use super::Isa;
 use crate::dynamics::vrm::{PlacedVrmCollider, VrmMode, VrmRig};
 use crate::math::{normalize_or, Transform};
 use crate::pose::compose_joints;
@@ -280,9 +283,9 @@ impl SpringLanes {
         w: f32,
         step_locals: &mut [Transform],
         step_models: &mut [Transform],
-        avx2: bool,
+        isa: Isa,
     ) {
-        super::lanes::lerp_transforms_at(prev, now, w, &self.step_read, step_locals, avx2);
+        super::lanes::lerp_transforms_at(prev, now, w, &self.step_read, step_locals, isa);
         let read = self.step_read.iter().copied();
         compose_joints(sk, read, None, step_locals, step_models);
         for &j in &self.step_links {
@@ -314,19 +317,18 @@ impl SpringLanes {
 
     /// The scalar update's results for every link (its tails, rotations, and the links'
     /// local rotations and model transforms in the pose; other joints' models are left
-    /// as they were, the job recomputes them), computed with AVX2 where `avx2` allows it
-    /// and the CPU has it.
-    pub(crate) fn update(&self, rig: &VrmRig, io: &mut SpringIo<'_>, avx2: bool) {
+    /// as they were, the job recomputes them), computed in the lane type `isa` chose.
+    pub(crate) fn update(&self, rig: &VrmRig, io: &mut SpringIo<'_>, isa: Isa) {
+        // SAFETY (both): the function only requires the instructions of its lane type,
+        // and `Isa::of` chose that type because the CPU has them.
         #[cfg(target_arch = "x86_64")]
-        if avx2 && std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: `update_avx2` only requires the AVX2 instructions, and the CPU was
-            // just checked to have them.
-            #[allow(unsafe_code)]
-            unsafe {
-                return self.update_avx2(rig, io);
-            }
+        #[allow(unsafe_code)]
+        match isa {
+            Isa::Avx512 => return unsafe { self.update_avx512(rig, io) },
+            Isa::Avx2 => return unsafe { self.update_avx2(rig, io) },
+            Isa::Portable => {}
         }
-        let _ = avx2;
+        let _ = isa;
         self.update_baseline(rig, io)
     }
 
@@ -343,20 +345,21 @@ impl SpringLanes {
         rig: &VrmRig,
         io: &mut SpringIo<'_>,
         w: f32,
-        avx2: bool,
+        isa: Isa,
     ) {
+        // SAFETY (both): as in `update`.
         #[cfg(target_arch = "x86_64")]
-        if avx2 && std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: as in `update`.
-            #[allow(unsafe_code)]
-            unsafe {
-                self.output_avx2(rig, io, w);
-            }
-            self.refresh_below(sk, io.locals, io.models);
-            return;
+        #[allow(unsafe_code)]
+        match isa {
+            Isa::Avx512 => unsafe { self.output_avx512(rig, io, w) },
+            Isa::Avx2 => unsafe { self.output_avx2(rig, io, w) },
+            Isa::Portable => self.output_baseline(rig, io, w),
         }
-        let _ = avx2;
-        self.output_baseline(rig, io, w);
+        #[cfg(not(target_arch = "x86_64"))]
+        {
+            let _ = isa;
+            self.output_baseline(rig, io, w);
+        }
         self.refresh_below(sk, io.locals, io.models);
     }
 
@@ -370,6 +373,13 @@ impl SpringLanes {
     #[inline(never)]
     fn output_avx2(&self, rig: &VrmRig, io: &mut SpringIo<'_>, w: f32) {
         self.output_lanes::<Fa>(rig, io, w)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f,avx512dq,avx512vl,avx512bw")]
+    #[inline(never)]
+    fn output_avx512(&self, rig: &VrmRig, io: &mut SpringIo<'_>, w: f32) {
+        self.output_lanes::<Fz>(rig, io, w)
     }
 
     #[inline(always)]
@@ -456,9 +466,18 @@ impl SpringLanes {
     #[target_feature(enable = "avx2")]
     #[inline(never)]
     fn update_avx2(&self, rig: &VrmRig, io: &mut SpringIo<'_>) {
-        // The explicit AVX lane type only inside this function, after the CPU was found
+        // The explicit AVX2 lane type only inside this function, after the CPU was found
         // to have AVX2 (the condition of its soundness, `crowd/avx.rs`).
         self.update_lanes::<Fa>(rig, io)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f,avx512dq,avx512vl,avx512bw")]
+    #[inline(never)]
+    fn update_avx512(&self, rig: &VrmRig, io: &mut SpringIo<'_>) {
+        // The explicit AVX-512 lane type only inside this function, after the CPU was
+        // found to have it (the condition of its soundness, `crowd/avx512.rs`).
+        self.update_lanes::<Fz>(rig, io)
     }
 
     #[inline(always)]

@@ -9,8 +9,11 @@
 
 #[cfg(target_arch = "x86_64")]
 use super::avx::Fa;
+#[cfg(target_arch = "x86_64")]
+use super::avx512::Fz;
 use super::lanes::{rotation_arc_from, Lane, Mask, Trs, F, LANES, M, Q, V3};
 use super::vrm_contact::{collide_tail, Placed};
+use super::{Isa, SimdUse};
 use crate::dynamics::path::CharacterPath;
 use crate::dynamics::vrm::{VrmMode, VrmRig, VrmShape};
 use crate::error::{Error, Result};
@@ -391,7 +394,7 @@ pub struct VrmCrowd {
     /// Per frame: each link's `stiffness · dt` and `gravity · dt`.
     stiffness_dt: Vec<f32>,
     external: Vec<Vec3>,
-    avx2: bool,
+    simd: SimdUse,
 }
 
 impl VrmCrowd {
@@ -415,13 +418,13 @@ impl VrmCrowd {
             scratch: Vec::new(),
             stiffness_dt: vec![0.0; links],
             external: vec![Vec3::ZERO; links],
-            avx2: true,
+            simd: SimdUse::Auto,
         })
     }
 
     /// Adds a character; returns its index. It starts from its pose on its first frame.
     pub fn add(&mut self) -> usize {
-        if self.len % LANES == 0 {
+        if self.len.is_multiple_of(LANES) {
             self.packs
                 .push(Pack::new(self.rig.links.len(), self.plan.joints.len()));
         }
@@ -457,11 +460,14 @@ impl VrmCrowd {
         Ok(())
     }
 
-    /// Allows (the default) or forbids the AVX2 code path on CPUs that have it. The results
-    /// are the same bits either way; forbidding it is for measuring and testing the
-    /// baseline (SSE2) path.
-    pub fn set_avx2(&mut self, allow: bool) {
-        self.avx2 = allow;
+    /// Which lane code steps the crowd: the widest the CPU has ([`SimdUse::Auto`], the
+    /// default: AVX-512, else AVX2, else portable), AVX2 at most ([`SimdUse::Avx2`]) or
+    /// the portable code ([`SimdUse::Portable`]; the crowd has no scalar code of its own,
+    /// so [`SimdUse::Scalar`] runs that too: its scalar reference is
+    /// [`crate::CharacterSim`]). The results are the same bits whichever runs; the
+    /// choice is for measuring and testing each.
+    pub fn set_simd(&mut self, simd: SimdUse) {
+        self.simd = simd;
     }
 
     /// Number of characters.
@@ -606,7 +612,7 @@ impl VrmCrowd {
             stiffness_dt: &self.stiffness_dt,
             external: &self.external,
             dt,
-            avx2: self.avx2,
+            isa: Isa::of(self.simd),
         };
         let input = &input;
         self.packs
@@ -634,15 +640,15 @@ struct Ctx<'c> {
     stiffness_dt: &'c [f32],
     external: &'c [Vec3],
     dt: f32,
-    avx2: bool,
+    isa: Isa,
 }
 
 impl Ctx<'_> {
-    /// Loads, checks and steps one lane group: with AVX2 where the CPU has it, in the
-    /// explicit AVX lane type (`crowd/avx.rs`; 1.2x faster than the same code over `F`
-    /// compiled for AVX2, which was 1.5x faster than SSE2: `tassel bench --crowd 200
-    /// --vrm spec`), else over `F` with the baseline SSE2. Every lane operation of both
-    /// is IEEE-exact, so both give the same bits.
+    /// Loads, checks and steps one lane group in the lane type `self.isa` chose: the
+    /// explicit AVX-512 or AVX2 type (`crowd/avx512.rs`, `crowd/avx.rs`; AVX2's was 1.2x
+    /// faster than the same code over `F` compiled for AVX2, which was 1.5x faster than
+    /// SSE2: `tassel bench --crowd 200 --vrm spec`), else over `F` with the baseline
+    /// SSE2. Every lane operation of each is IEEE-exact, so all give the same bits.
     fn run<'a, I>(
         &self,
         pack: &mut Pack,
@@ -653,14 +659,14 @@ impl Ctx<'_> {
     where
         I: Fn(usize) -> CrowdPose<'a> + Sync,
     {
+        // SAFETY (both): the function only requires the instructions of its lane type,
+        // and `Isa::of` chose that type because the CPU has them.
         #[cfg(target_arch = "x86_64")]
-        if self.avx2 && std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: `run_avx2` only requires the AVX2 instructions, and the CPU was
-            // just checked to have them.
-            #[allow(unsafe_code)]
-            unsafe {
-                return self.run_avx2(pack, scratch, base, input);
-            }
+        #[allow(unsafe_code)]
+        match self.isa {
+            Isa::Avx512 => return unsafe { self.run_avx512(pack, scratch, base, input) },
+            Isa::Avx2 => return unsafe { self.run_avx2(pack, scratch, base, input) },
+            Isa::Portable => {}
         }
         self.gather::<F, I>(pack, scratch, base, input)?;
         self.step_baseline(pack, scratch);
@@ -679,10 +685,29 @@ impl Ctx<'_> {
     where
         I: Fn(usize) -> CrowdPose<'a> + Sync,
     {
-        // The explicit AVX lane type only inside this function, after the CPU was
+        // The explicit AVX2 lane type only inside this function, after the CPU was
         // found to have AVX2 (the condition of its soundness).
         self.gather::<Fa, I>(pack, scratch, base, input)?;
         self.step_avx2(pack, scratch);
+        Ok(())
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f,avx512dq,avx512vl,avx512bw")]
+    fn run_avx512<'a, I>(
+        &self,
+        pack: &mut Pack,
+        scratch: &mut Scratch,
+        base: usize,
+        input: &I,
+    ) -> std::result::Result<(), (usize, Error)>
+    where
+        I: Fn(usize) -> CrowdPose<'a> + Sync,
+    {
+        // The explicit AVX-512 lane type only inside this function, after the CPU was
+        // found to have it (the condition of its soundness).
+        self.gather::<Fz, I>(pack, scratch, base, input)?;
+        self.step_avx512(pack, scratch);
         Ok(())
     }
 
@@ -698,6 +723,13 @@ impl Ctx<'_> {
     #[inline(never)]
     fn step_avx2(&self, pack: &mut Pack, s: &mut Scratch) {
         self.step_lanes::<Fa>(pack, s)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f,avx512dq,avx512vl,avx512bw")]
+    #[inline(never)]
+    fn step_avx512(&self, pack: &mut Pack, s: &mut Scratch) {
+        self.step_lanes::<Fz>(pack, s)
     }
 
     /// [`Ctx::gather_checked`]'s result, faster where the input is good and no

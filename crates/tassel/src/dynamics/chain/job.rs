@@ -6,7 +6,7 @@ use super::step::{step_chain, StepInput};
 use crate::collide::{NearSet, PlacedCollider};
 use crate::controller::Level;
 use crate::crowd::chain_lanes::{ChainLanes, LaneFrame, ScalarChains};
-use crate::crowd::SimdUse;
+use crate::crowd::{Isa, SimdUse};
 use crate::dynamics::path::CharacterPath;
 use crate::dynamics::world::{push_out, WorldContact};
 use crate::error::{Error, Result};
@@ -309,7 +309,7 @@ impl ChainJob<'_> {
             let frame = LaneFrame {
                 component,
                 dt,
-                avx2: state.simd == SimdUse::Auto,
+                isa: Isa::of(state.simd),
             };
             for (group, lanes) in rig.lane_groups.iter().zip(&mut state.lanes) {
                 lanes.frame(
@@ -336,7 +336,7 @@ impl ChainJob<'_> {
                     locals,
                     models,
                     &mut state.turned,
-                    state.simd == SimdUse::Auto,
+                    Isa::of(state.simd),
                 );
             }
         }

@@ -5,7 +5,7 @@ use super::contact::{push_segment, push_triangle_against, Core};
 use crate::collide::PlacedCollider;
 use crate::controller::Level;
 use crate::crowd::cloth_lanes::{self, ClothLaneScratch};
-use crate::crowd::SimdUse;
+use crate::crowd::{Isa, SimdUse};
 use crate::dynamics::path::CharacterPath;
 use crate::dynamics::world::collide_points;
 use crate::error::{Error, Result};
@@ -462,8 +462,8 @@ fn step(rig: &ClothRig, ci: usize, state: &mut ClothState, h: f32, level: Option
     if s.limit_angle > 0.0 {
         match state.simd {
             SimdUse::Scalar => limit_angles(rig, ci, &state.step_targets, &mut state.pos),
-            SimdUse::Portable | SimdUse::Auto => cloth_lanes::limit_angles(
-                state.simd == SimdUse::Auto,
+            SimdUse::Portable | SimdUse::Avx2 | SimdUse::Auto => cloth_lanes::limit_angles(
+                Isa::of(state.simd),
                 rig,
                 ci,
                 &state.step_targets,
@@ -533,8 +533,8 @@ fn collide_with(
 ) -> bool {
     match simd {
         SimdUse::Scalar => collide(rig, ci, colliders, pos, prev, contact, surfaces, cores),
-        SimdUse::Portable | SimdUse::Auto => cloth_lanes::collide(
-            simd == SimdUse::Auto,
+        SimdUse::Portable | SimdUse::Avx2 | SimdUse::Auto => cloth_lanes::collide(
+            Isa::of(simd),
             rig,
             ci,
             colliders,

@@ -6,7 +6,7 @@ use super::compile::{VrmLink, VrmRig};
 use super::settings::VrmMode;
 use crate::crowd::spring_lanes::{SpringIo, SpringLanes};
 use crate::crowd::vrm_contact::Placed;
-use crate::crowd::SimdUse;
+use crate::crowd::{Isa, SimdUse};
 use crate::dynamics::path::CharacterPath;
 use crate::error::{Error, Result};
 use crate::math::{normalize_or, rotation_arc, slerp_shortest, Transform};
@@ -366,9 +366,9 @@ fn collide_output(
     if let Some(lanes) = lane_plan(rig, state) {
         // The same results, several springs at a time (`crowd/spring_lanes.rs`), which
         // also turn the links to their output rotations (`w`).
-        let avx2 = state.simd == SimdUse::Auto;
+        let isa = Isa::of(state.simd);
         let mut io = state.lane_io(component, 0.0, VrmMode::Fixed, locals, models);
-        lanes.collide_output(sk, rig, &mut io, w, avx2);
+        lanes.collide_output(sk, rig, &mut io, w, isa);
         return;
     }
     let mut stale_from = sk.len();
@@ -481,9 +481,9 @@ fn update(
         // The same results, several springs at a time (`crowd/spring_lanes.rs`); the
         // models of joints that are not links are left stale: every caller recomputes
         // the whole model pose before reading them.
-        let avx2 = state.simd == SimdUse::Auto;
+        let isa = Isa::of(state.simd);
         let mut io = state.lane_io(component, dt, mode, locals, models);
-        lanes.update(rig, &mut io, avx2);
+        lanes.update(rig, &mut io, isa);
         return true;
     }
     let exact = mode == VrmMode::Fixed;
@@ -673,9 +673,9 @@ fn run_fixed(sk: &Skeleton, rig: &VrmRig, state: &mut VrmState, dt: f32, locals:
             Some(lanes) => {
                 // Only what the lane update and the colliders read of the step's pose (the
                 // same values where they read it).
-                let avx2 = state.simd == SimdUse::Auto;
+                let isa = Isa::of(state.simd);
                 let frames = (&state.prev_locals[..], locals);
-                lanes.step_pose(sk, frames, w, &mut step_locals, &mut step_models, avx2);
+                lanes.step_pose(sk, frames, w, &mut step_locals, &mut step_models, isa);
             }
             None => {
                 for (s, (a, b)) in step_locals

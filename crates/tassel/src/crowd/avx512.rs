@@ -1,0 +1,271 @@
+//! The crowd's AVX-512 lane type: [`Fz`], one `__m512` per [`F`], every operation one
+//! 512-bit instruction, its conditions ([`Mz`]) one bit per lane in a mask register.
+//!
+//! Why it exists: on a CPU with AVX-512 (this project's 2-core AMD EPYC has it, at full
+//! width), one instruction advances all sixteen lanes of a group where the AVX2 type
+//! (`crowd/avx.rs`) needs two; conditions live in mask registers, so `select` is one
+//! blend and `any` one test of a general register.
+//!
+//! Each operation is the IEEE operation per lane that [`F`]'s is (add, subtract,
+//! multiply, divide, square root: correctly rounded; negation and `abs`: the sign bit;
+//! comparisons: ordered, `!=` unordered as Rust's; select: per lane), so both types give
+//! the same bits; `tests` checks it operation by operation.
+//!
+//! **Soundness.** The intrinsics need AVX-512 (F, and DQ/VL/BW enabled alongside). [`Fz`]
+//! and [`Mz`] are private to the crowd and only ever created inside functions compiled
+//! with `#[target_feature(enable = "avx512f,avx512dq,avx512vl,avx512bw")]` that are
+//! called where [`crate::crowd::Isa::of`] said [`crate::crowd::Isa::Avx512`], which it
+//! says only after `is_x86_feature_detected!` found all four (the `*_avx512` functions
+//! beside each `*_avx2` one; `entry_avx512` in `entry_lanes.rs`, called only where an
+//! [`Fz`] exists already; the tests below check the same first), so no AVX-512
+//! instruction runs on a CPU without it. The operations are `#[inline(always)]` so that
+//! they are compiled inside those functions.
+#![allow(unsafe_code)]
+
+use super::lanes::{Lane, Mask, F, M};
+use super::Isa;
+use std::arch::x86_64::*;
+use std::ops::{Add, Div, Mul, Neg, Sub};
+
+/// Sixteen `f32` lanes in one AVX-512 register.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Fz(__m512);
+
+/// A per-lane condition of [`Fz`]: one bit per lane.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Mz(__mmask16);
+
+macro_rules! binary {
+    ($tr:ident, $f:ident, $intr:ident) => {
+        impl $tr for Fz {
+            type Output = Fz;
+            #[inline(always)]
+            fn $f(self, o: Fz) -> Fz {
+                // SAFETY: see the module's documentation (only run where AVX-512 is).
+                Fz(unsafe { $intr(self.0, o.0) })
+            }
+        }
+    };
+}
+binary!(Add, add, _mm512_add_ps);
+binary!(Sub, sub, _mm512_sub_ps);
+binary!(Mul, mul, _mm512_mul_ps);
+binary!(Div, div, _mm512_div_ps);
+
+impl Neg for Fz {
+    type Output = Fz;
+    #[inline(always)]
+    fn neg(self) -> Fz {
+        // SAFETY: see the module's documentation. Flips the sign bit, as `-x` does.
+        Fz(unsafe {
+            _mm512_castsi512_ps(_mm512_xor_si512(
+                _mm512_castps_si512(self.0),
+                _mm512_set1_epi32(i32::MIN),
+            ))
+        })
+    }
+}
+
+impl Lane for Fz {
+    type M = Mz;
+    const ISA: Isa = Isa::Avx512;
+    #[inline(always)]
+    fn splat(v: f32) -> Fz {
+        // SAFETY: see the module's documentation.
+        Fz(unsafe { _mm512_set1_ps(v) })
+    }
+    #[inline(always)]
+    fn of(f: F) -> Fz {
+        // SAFETY: `F` is sixteen `f32` aligned to 64 bytes; an aligned load of them.
+        Fz(unsafe { _mm512_load_ps(f.0.as_ptr()) })
+    }
+    #[inline(always)]
+    fn f(self) -> F {
+        let mut f = F([0.0; 16]);
+        // SAFETY: an aligned store into `F`'s sixteen `f32`, aligned to 64 bytes.
+        unsafe { _mm512_store_ps(f.0.as_mut_ptr(), self.0) };
+        f
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Fz {
+        // SAFETY: see the module's documentation.
+        Fz(unsafe { _mm512_sqrt_ps(self.0) })
+    }
+    #[inline(always)]
+    fn abs(self) -> Fz {
+        // SAFETY: see the module's documentation. Clears the sign bit, as `f32::abs`.
+        Fz(unsafe { _mm512_abs_ps(self.0) })
+    }
+    #[inline(always)]
+    fn lt(self, o: Fz) -> Mz {
+        // SAFETY: see the module's documentation. Ordered: false with NaN, as `<`.
+        Mz(unsafe { _mm512_cmp_ps_mask::<_CMP_LT_OQ>(self.0, o.0) })
+    }
+    #[inline(always)]
+    fn le(self, o: Fz) -> Mz {
+        // SAFETY: see the module's documentation. Ordered: false with NaN, as `<=`.
+        Mz(unsafe { _mm512_cmp_ps_mask::<_CMP_LE_OQ>(self.0, o.0) })
+    }
+    #[inline(always)]
+    fn ne(self, o: Fz) -> Mz {
+        // SAFETY: see the module's documentation. Unordered: true with NaN, as `!=`.
+        Mz(unsafe { _mm512_cmp_ps_mask::<_CMP_NEQ_UQ>(self.0, o.0) })
+    }
+    #[inline(always)]
+    fn finite(self) -> Mz {
+        // |x| < ∞: false for NaN (ordered) and for ±∞, true for every finite value.
+        self.abs().lt(Fz::splat(f32::INFINITY))
+    }
+    #[inline(always)]
+    fn bits_eq(self, o: Fz) -> Mz {
+        // SAFETY: see the module's documentation. Equal 32-bit integers are equal
+        // `f32::to_bits`.
+        Mz(unsafe {
+            _mm512_cmpeq_epi32_mask(_mm512_castps_si512(self.0), _mm512_castps_si512(o.0))
+        })
+    }
+    #[inline(always)]
+    fn select(m: Mz, a: Fz, b: Fz) -> Fz {
+        // SAFETY: see the module's documentation. Picks `a` where the lane's bit is set.
+        Fz(unsafe { _mm512_mask_blend_ps(m.0, b.0, a.0) })
+    }
+}
+
+impl Mask for Mz {
+    const NONE: Mz = Mz(0);
+    const ALL: Mz = Mz(0xffff);
+    #[inline(always)]
+    fn and(self, o: Mz) -> Mz {
+        Mz(self.0 & o.0)
+    }
+    #[inline(always)]
+    fn or(self, o: Mz) -> Mz {
+        Mz(self.0 | o.0)
+    }
+    #[inline(always)]
+    fn not(self) -> Mz {
+        Mz(!self.0)
+    }
+    #[inline(always)]
+    fn any(self) -> bool {
+        self.0 != 0
+    }
+    #[inline(always)]
+    fn of(m: M) -> Mz {
+        // SAFETY: `M` is sixteen `u32` aligned to 64 bytes: an aligned load; a lane is
+        // set where its bits are not zero (they are all ones or all zeros).
+        Mz(unsafe {
+            let v = _mm512_load_si512(m.0.as_ptr().cast());
+            _mm512_test_epi32_mask(v, v)
+        })
+    }
+    #[inline(always)]
+    fn m(self) -> M {
+        let mut m = M([0; 16]);
+        // SAFETY: all ones in the set lanes, stored aligned into `M` (64 bytes).
+        unsafe {
+            _mm512_store_si512(
+                m.0.as_mut_ptr().cast(),
+                _mm512_maskz_mov_epi32(self.0, _mm512_set1_epi32(-1)),
+            )
+        };
+        m
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rng::SplitMix64 as Rng;
+
+    /// Runs `f` only where the CPU has AVX-512 (the type's precondition), saying so else.
+    fn with_avx512(f: impl FnOnce()) {
+        if Isa::of(crate::crowd::SimdUse::Auto) == Isa::Avx512 {
+            f()
+        } else {
+            eprintln!("skipped: this CPU has no AVX-512, the AVX-512 lane type cannot run here");
+        }
+    }
+
+    fn same(a: F, b: F) -> bool {
+        a.0.iter()
+            .zip(b.0.iter())
+            .all(|(x, y)| x.to_bits() == y.to_bits())
+    }
+
+    /// Values with every special case: ±0, ±∞, NaN, subnormals, huge, tiny, ordinary.
+    fn values(rng: &mut Rng) -> F {
+        let special = [
+            0.0,
+            -0.0,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::NAN,
+            1e-40,
+            -1e-40,
+            3.4e38,
+            -3.4e38,
+            1e-30,
+            1.0,
+            -1.0,
+        ];
+        F(std::array::from_fn(|_| {
+            let r = rng.next_u64();
+            if r.is_multiple_of(4) {
+                special[(r >> 8) as usize % special.len()]
+            } else {
+                let x = (rng.next_u64() % 2_000_000) as f32 / 1000.0 - 1000.0;
+                if r % 4 == 1 {
+                    x * 1e-3
+                } else {
+                    x
+                }
+            }
+        }))
+    }
+
+    #[test]
+    fn avx512_lane_operations_give_the_bits_of_f() {
+        with_avx512(|| {
+            let mut rng = Rng::new(0xA5A5);
+            for _ in 0..20_000 {
+                let (a, b) = (values(&mut rng), values(&mut rng));
+                let (x, y) = (Fz::of(a), Fz::of(b));
+                assert!(same((x + y).f(), a + b), "{a:?} + {b:?}");
+                assert!(same((x - y).f(), a - b), "{a:?} - {b:?}");
+                assert!(same((x * y).f(), a * b), "{a:?} * {b:?}");
+                assert!(same((x / y).f(), a / b), "{a:?} / {b:?}");
+                assert!(same((-x).f(), -a), "-{a:?}");
+                assert!(same(x.sqrt().f(), a.sqrt()), "sqrt {a:?}");
+                assert!(same(Lane::abs(x).f(), a.abs()), "abs {a:?}");
+                assert!(same(Lane::clamp01(x).f(), a.clamp01()), "clamp01 {a:?}");
+                assert!(same(Lane::max(x, y).f(), a.max(b)), "max {a:?} {b:?}");
+                assert!(same(Lane::signum(x).f(), F(a.0.map(f32::signum))));
+                assert_eq!(Lane::lt(x, y).m(), a.lt(b), "{a:?} < {b:?}");
+                assert_eq!(Lane::le(x, y).m(), a.le(b), "{a:?} <= {b:?}");
+                assert_eq!(Lane::gt(x, y).m(), a.gt(b), "{a:?} > {b:?}");
+                assert_eq!(Lane::ne(x, y).m(), a.ne(b), "{a:?} != {b:?}");
+                assert_eq!(Lane::finite(x).m(), a.finite(), "finite {a:?}");
+                assert_eq!(
+                    Lane::bits_eq(x, y).m(),
+                    Lane::bits_eq(a, b),
+                    "{a:?} bits {b:?}"
+                );
+                assert_eq!(Lane::bits_eq(x, x).m(), M::ALL, "{a:?} bits itself");
+                let m = a.lt(b);
+                let (mx, ma) = (Mz::of(m), m);
+                assert!(same(Fz::select(mx, x, y).f(), F::select(ma, a, b)));
+                let n = b.finite();
+                let nx = Mz::of(n);
+                assert_eq!(mx.and(nx).m(), ma.and(n));
+                assert_eq!(mx.or(nx).m(), ma.or(n));
+                assert_eq!(Mask::not(mx).m(), ma.not());
+                assert_eq!(Mask::any(mx), ma.any());
+                assert_eq!(mx == Mz::ALL, ma == M::ALL);
+                assert_eq!(mx == Mz::NONE, ma == M::NONE);
+                assert_eq!(x.get(3).to_bits(), a.0[3].to_bits());
+                assert_eq!(x.get(12).to_bits(), a.0[12].to_bits());
+            }
+        });
+    }
+}
