@@ -227,6 +227,12 @@ impl Mask for Ma {
         unsafe { _mm256_movemask_ps(_mm256_or_ps(self.0, self.1)) != 0 }
     }
     #[inline(always)]
+    fn several(self) -> bool {
+        // SAFETY: as in `any`: the sign bits are the mask, one bit per lane.
+        let bits = unsafe { _mm256_movemask_ps(self.0) | _mm256_movemask_ps(self.1) << 8 };
+        bits & bits.wrapping_sub(1) != 0
+    }
+    #[inline(always)]
     fn of(m: M) -> Ma {
         // SAFETY: `M` is sixteen `u32` aligned to 64 bytes: two aligned loads of its
         // halves' bits.
@@ -336,10 +342,31 @@ mod tests {
                 assert_eq!(mx.or(nx).m(), ma.or(n));
                 assert_eq!(Mask::not(mx).m(), ma.not());
                 assert_eq!(Mask::any(mx), ma.any());
+                assert_eq!(Mask::several(mx), Mask::several(ma));
                 assert_eq!(mx == Ma::ALL, ma == M::ALL);
                 assert_eq!(mx == Ma::NONE, ma == M::NONE);
                 assert_eq!(x.get(3).to_bits(), a.0[3].to_bits());
                 assert_eq!(x.get(12).to_bits(), a.0[12].to_bits());
+            }
+        });
+    }
+
+    /// `several` is "more than one lane set", for every single lane and pair of lanes.
+    #[test]
+    fn several_means_more_than_one_lane() {
+        with_avx2(|| {
+            assert!(!Mask::several(Ma::NONE));
+            for i in 0..16 {
+                let mut one = M::NONE;
+                one.0[i] = !0;
+                assert!(!Mask::several(Ma::of(one)), "lane {i} alone");
+                assert!(!Mask::several(one), "lane {i} alone");
+                for j in (0..16).filter(|&j| j != i) {
+                    let mut two = one;
+                    two.0[j] = !0;
+                    assert!(Mask::several(Ma::of(two)), "lanes {i} and {j}");
+                    assert!(Mask::several(two), "lanes {i} and {j}");
+                }
             }
         });
     }

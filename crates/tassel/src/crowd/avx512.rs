@@ -151,6 +151,10 @@ impl Mask for Mz {
         self.0 != 0
     }
     #[inline(always)]
+    fn several(self) -> bool {
+        self.0 & self.0.wrapping_sub(1) != 0
+    }
+    #[inline(always)]
     fn of(m: M) -> Mz {
         // SAFETY: `M` is sixteen `u32` aligned to 64 bytes: an aligned load; a lane is
         // set where its bits are not zero (they are all ones or all zeros).
@@ -261,10 +265,31 @@ mod tests {
                 assert_eq!(mx.or(nx).m(), ma.or(n));
                 assert_eq!(Mask::not(mx).m(), ma.not());
                 assert_eq!(Mask::any(mx), ma.any());
+                assert_eq!(Mask::several(mx), Mask::several(ma));
                 assert_eq!(mx == Mz::ALL, ma == M::ALL);
                 assert_eq!(mx == Mz::NONE, ma == M::NONE);
                 assert_eq!(x.get(3).to_bits(), a.0[3].to_bits());
                 assert_eq!(x.get(12).to_bits(), a.0[12].to_bits());
+            }
+        });
+    }
+
+    /// `several` is "more than one lane set", for every single lane and pair of lanes.
+    #[test]
+    fn several_means_more_than_one_lane() {
+        with_avx512(|| {
+            assert!(!Mask::several(Mz::NONE));
+            for i in 0..16 {
+                let mut one = M::NONE;
+                one.0[i] = !0;
+                assert!(!Mask::several(Mz::of(one)), "lane {i} alone");
+                assert!(!Mask::several(one), "lane {i} alone");
+                for j in (0..16).filter(|&j| j != i) {
+                    let mut two = one;
+                    two.0[j] = !0;
+                    assert!(Mask::several(Mz::of(two)), "lanes {i} and {j}");
+                    assert!(Mask::several(two), "lanes {i} and {j}");
+                }
             }
         });
     }

@@ -14,6 +14,7 @@ use super::lanes::{
     angle_between, closest_params_segment_segment, closest_point_on_segment, differs,
     turned_toward, Lane, Mask, F, LANES, M, Q, V3,
 };
+use super::Isa;
 use crate::collide::{PlacedCollider, Shape};
 use crate::dynamics::chain::compile::{ChainRig, NONE};
 use crate::dynamics::chain::step::pull;
@@ -570,6 +571,11 @@ fn collide<T: Lane>(
                     sphere_entry(y, q, bc, limit, &contact),
                     <T::M as Mask>::NONE,
                 ),
+                // Without AVX-512, one lane alone goes to the scalar narrow phase (the
+                // same bits): the closed form in `f64` costs as much for one lane as for
+                // all sixteen, in four 256-bit registers a value (`tassel bench --simd
+                // avx2` 7 % faster; with AVX-512 2 % slower, so not there).
+                true if T::ISA != Isa::Avx512 && !ask.several() => (y, ask),
                 true => capsule_entry_out_of_line(y, q, a, b, limit, &contact, ask),
             };
             let slid = ask.and(hard.not());

@@ -323,6 +323,11 @@ pub trait Mask: Copy + PartialEq {
     fn not(self) -> Self;
     /// Any lane set.
     fn any(self) -> bool;
+    /// More than one lane set.
+    #[inline(always)]
+    fn several(self) -> bool {
+        self.m().0.iter().filter(|&&x| x != 0).count() > 1
+    }
     /// From [`M`] (the same lanes).
     fn of(m: M) -> Self;
     /// As [`M`] (the same lanes).
