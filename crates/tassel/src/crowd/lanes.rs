@@ -1169,6 +1169,7 @@ pub(crate) fn lerp_transforms_at(
     out: &mut [Transform],
     isa: super::Isa,
 ) {
+    #[cfg(target_arch = "x86_64")]
     use super::Isa;
     // SAFETY (both): the function only requires the instructions of its lane type, and
     // `Isa::of` chose that type because the CPU has them.
