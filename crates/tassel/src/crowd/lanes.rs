@@ -8,9 +8,10 @@
 //!
 //! [`V3`], [`Q`] and [`Trs`] are generic over their per-lane type ([`Lane`]): [`F`],
 //! whose per-element loops are left to the compiler to vectorise (plain stable Rust,
-//! every target), and on x86_64 the crowd's private AVX type (`crowd/avx.rs`: one 256-bit
-//! instruction per operation, used inside the crowds' AVX2 functions only). State stays
-//! in [`F`]; `of` and `f` convert (the same bytes).
+//! every target), and on x86_64 the crowd's private explicit types, used inside the
+//! crowds' AVX-512 and AVX2 functions only: `crowd/avx512.rs` (one 512-bit instruction per
+//! operation) and `crowd/avx.rs` (two 256-bit ones). [`crate::crowd::Isa::of`] chooses
+//! at run time. State stays in [`F`]; `of` and `f` convert (the same bytes).
 
 use crate::math::Transform;
 use glam::{Quat, Vec3};
@@ -21,15 +22,7 @@ use std::ops::{Add, Div, Mul, Neg, Sub};
 /// portable lane type over arrays, which the compiler splits into the target's vectors:
 /// sixteen would need more registers than SSE or NEON have, measured 1.4x slower on
 /// x86_64 without AVX).
-#[cfg(target_arch = "x86_64")]
-pub const LANES: usize = 16;
-/// Characters per lane group: 16 on x86_64, where one AVX-512 register holds them (a CPU
-/// with AVX2 only takes them in two registers, `crowd/avx.rs`), 8 elsewhere (the
-/// portable lane type over arrays, which the compiler splits into the target's vectors:
-/// sixteen would need more registers than SSE or NEON have, measured 1.4x slower on
-/// x86_64 without AVX).
-#[cfg(not(target_arch = "x86_64"))]
-pub const LANES: usize = 8;
+pub const LANES: usize = if cfg!(target_arch = "x86_64") { 16 } else { 8 };
 
 /// One `f32` per lane.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -1034,6 +1027,12 @@ pub(crate) fn turned_toward<T: Lane>(
     turn.mul_vec3(unit_from)
 }
 
+/// `x < 0` per lane.
+#[inline(always)]
+fn is_negative<T: Lane>(x: T) -> T::M {
+    x.lt(T::splat(0.0))
+}
+
 /// glam's SSE2 `m128_sin` (DirectXMath's 11th-degree minimax after reduction to
 /// [-π, π] and reflection into [-π/2, π/2]), per lane.
 ///
@@ -1041,12 +1040,6 @@ pub(crate) fn turned_toward<T: Lane>(
 /// only for -0 and NaN. Rounding -0 with either sign of 2²³ gives +0; a NaN rounds to
 /// itself either way; and the reflection never takes π's sign for -0 (|-0| ≤ π/2) and
 /// gives the NaN for a NaN (`π − NaN`).
-/// `x < 0` per lane.
-#[inline(always)]
-fn is_negative<T: Lane>(x: T) -> T::M {
-    x.lt(T::splat(0.0))
-}
-
 #[inline(always)]
 fn sin_approx<T: Lane>(v: T) -> T {
     let c = T::splat;
