@@ -257,7 +257,7 @@ impl Mask for Ma {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::rng::SplitMix64 as Rng;
+    use crate::crowd::lane_check;
 
     /// Runs `f` only where the CPU has AVX2 (the type's precondition), saying so else.
     fn with_avx2(f: impl FnOnce()) {
@@ -268,106 +268,14 @@ mod tests {
         }
     }
 
-    fn same(a: F, b: F) -> bool {
-        a.0.iter()
-            .zip(b.0.iter())
-            .all(|(x, y)| x.to_bits() == y.to_bits())
-    }
-
-    /// Values with every special case: ±0, ±∞, NaN, subnormals, huge, tiny, ordinary.
-    fn values(rng: &mut Rng) -> F {
-        let special = [
-            0.0,
-            -0.0,
-            f32::INFINITY,
-            f32::NEG_INFINITY,
-            f32::NAN,
-            1e-40,
-            -1e-40,
-            3.4e38,
-            -3.4e38,
-            1e-30,
-            1.0,
-            -1.0,
-        ];
-        F(std::array::from_fn(|_| {
-            let r = rng.next_u64();
-            if r.is_multiple_of(4) {
-                special[(r >> 8) as usize % special.len()]
-            } else {
-                let x = (rng.next_u64() % 2_000_000) as f32 / 1000.0 - 1000.0;
-                if r % 4 == 1 {
-                    x * 1e-3
-                } else {
-                    x
-                }
-            }
-        }))
-    }
-
     #[test]
     fn avx_lane_operations_give_the_bits_of_f() {
-        with_avx2(|| {
-            let mut rng = Rng::new(0xA5A5);
-            for _ in 0..20_000 {
-                let (a, b) = (values(&mut rng), values(&mut rng));
-                let (x, y) = (Fa::of(a), Fa::of(b));
-                assert!(same((x + y).f(), a + b), "{a:?} + {b:?}");
-                assert!(same((x - y).f(), a - b), "{a:?} - {b:?}");
-                assert!(same((x * y).f(), a * b), "{a:?} * {b:?}");
-                assert!(same((x / y).f(), a / b), "{a:?} / {b:?}");
-                assert!(same((-x).f(), -a), "-{a:?}");
-                assert!(same(x.sqrt().f(), a.sqrt()), "sqrt {a:?}");
-                assert!(same(Lane::abs(x).f(), a.abs()), "abs {a:?}");
-                assert!(same(Lane::clamp01(x).f(), a.clamp01()), "clamp01 {a:?}");
-                assert!(same(Lane::max(x, y).f(), a.max(b)), "max {a:?} {b:?}");
-                assert!(same(Lane::signum(x).f(), F(a.0.map(f32::signum))));
-                assert_eq!(Lane::lt(x, y).m(), a.lt(b), "{a:?} < {b:?}");
-                assert_eq!(Lane::le(x, y).m(), a.le(b), "{a:?} <= {b:?}");
-                assert_eq!(Lane::gt(x, y).m(), a.gt(b), "{a:?} > {b:?}");
-                assert_eq!(Lane::ne(x, y).m(), a.ne(b), "{a:?} != {b:?}");
-                assert_eq!(Lane::finite(x).m(), a.finite(), "finite {a:?}");
-                assert_eq!(
-                    Lane::bits_eq(x, y).m(),
-                    Lane::bits_eq(a, b),
-                    "{a:?} bits {b:?}"
-                );
-                assert_eq!(Lane::bits_eq(x, x).m(), M::ALL, "{a:?} bits itself");
-                let m = a.lt(b);
-                let (mx, ma) = (Ma::of(m), m);
-                assert!(same(Fa::select(mx, x, y).f(), F::select(ma, a, b)));
-                let n = b.finite();
-                let nx = Ma::of(n);
-                assert_eq!(mx.and(nx).m(), ma.and(n));
-                assert_eq!(mx.or(nx).m(), ma.or(n));
-                assert_eq!(Mask::not(mx).m(), ma.not());
-                assert_eq!(Mask::any(mx), ma.any());
-                assert_eq!(Mask::several(mx), Mask::several(ma));
-                assert_eq!(mx == Ma::ALL, ma == M::ALL);
-                assert_eq!(mx == Ma::NONE, ma == M::NONE);
-                assert_eq!(x.get(3).to_bits(), a.0[3].to_bits());
-                assert_eq!(x.get(12).to_bits(), a.0[12].to_bits());
-            }
-        });
+        with_avx2(lane_check::operations_give_the_bits_of_f::<Fa>);
     }
 
     /// `several` is "more than one lane set", for every single lane and pair of lanes.
     #[test]
     fn several_means_more_than_one_lane() {
-        with_avx2(|| {
-            assert!(!Mask::several(Ma::NONE));
-            for i in 0..16 {
-                let mut one = M::NONE;
-                one.0[i] = !0;
-                assert!(!Mask::several(Ma::of(one)), "lane {i} alone");
-                assert!(!Mask::several(one), "lane {i} alone");
-                for j in (0..16).filter(|&j| j != i) {
-                    let mut two = one;
-                    two.0[j] = !0;
-                    assert!(Mask::several(Ma::of(two)), "lanes {i} and {j}");
-                    assert!(Mask::several(two), "lanes {i} and {j}");
-                }
-            }
-        });
+        with_avx2(lane_check::several_means_more_than_one_lane::<Fa>);
     }
 }

@@ -19,6 +19,8 @@ pub(crate) mod chain_lanes;
 mod chain_step;
 pub(crate) mod cloth_lanes;
 mod entry_lanes;
+#[cfg(all(test, target_arch = "x86_64"))]
+mod lane_check;
 pub mod lanes;
 pub(crate) mod spring_lanes;
 mod vrm;
