@@ -192,6 +192,17 @@ impl Lane for Fa {
             )
         }
     }
+    #[inline(always)]
+    fn max_gt(self, o: Fa) -> Fa {
+        // SAFETY: see the module's documentation. `vmaxps` is `a > b ? a : b` exactly
+        // (the second operand where either is NaN, and of two zeros).
+        unsafe { Fa(_mm256_max_ps(self.0, o.0), _mm256_max_ps(self.1, o.1)) }
+    }
+    #[inline(always)]
+    fn min_lt(self, o: Fa) -> Fa {
+        // SAFETY: see the module's documentation. `vminps` is `a < b ? a : b` exactly.
+        unsafe { Fa(_mm256_min_ps(self.0, o.0), _mm256_min_ps(self.1, o.1)) }
+    }
 }
 
 impl Mask for Ma {

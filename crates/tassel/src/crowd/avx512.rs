@@ -129,6 +129,17 @@ impl Lane for Fz {
         // SAFETY: see the module's documentation. Picks `a` where the lane's bit is set.
         Fz(unsafe { _mm512_mask_blend_ps(m.0, b.0, a.0) })
     }
+    #[inline(always)]
+    fn max_gt(self, o: Fz) -> Fz {
+        // SAFETY: see the module's documentation. `vmaxps` is `a > b ? a : b` exactly
+        // (the second operand where either is NaN, and of two zeros).
+        Fz(unsafe { _mm512_max_ps(self.0, o.0) })
+    }
+    #[inline(always)]
+    fn min_lt(self, o: Fz) -> Fz {
+        // SAFETY: see the module's documentation. `vminps` is `a < b ? a : b` exactly.
+        Fz(unsafe { _mm512_min_ps(self.0, o.0) })
+    }
 }
 
 impl Mask for Mz {

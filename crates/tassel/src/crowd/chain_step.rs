@@ -374,7 +374,7 @@ pub(super) fn entry_possible<T: Lane>(
 /// when it is not inlined itself.)
 #[inline(always)]
 fn select_max<T: Lane>(x: T, y: T) -> T {
-    T::select(x.gt(y), x, y)
+    x.max_gt(y)
 }
 
 /// The largest coordinate's size per lane.
@@ -417,9 +417,9 @@ pub(super) struct LaneStep<'a> {
 #[inline(always)]
 pub(super) fn vmin<T: Lane>(a: V3<T>, b: V3<T>) -> V3<T> {
     V3 {
-        x: T::select(a.x.lt(b.x), a.x, b.x),
-        y: T::select(a.y.lt(b.y), a.y, b.y),
-        z: T::select(a.z.lt(b.z), a.z, b.z),
+        x: a.x.min_lt(b.x),
+        y: a.y.min_lt(b.y),
+        z: a.z.min_lt(b.z),
     }
 }
 
@@ -427,9 +427,9 @@ pub(super) fn vmin<T: Lane>(a: V3<T>, b: V3<T>) -> V3<T> {
 #[inline(always)]
 pub(super) fn vmax<T: Lane>(a: V3<T>, b: V3<T>) -> V3<T> {
     V3 {
-        x: T::select(a.x.gt(b.x), a.x, b.x),
-        y: T::select(a.y.gt(b.y), a.y, b.y),
-        z: T::select(a.z.gt(b.z), a.z, b.z),
+        x: a.x.max_gt(b.x),
+        y: a.y.max_gt(b.y),
+        z: a.z.max_gt(b.z),
     }
 }
 

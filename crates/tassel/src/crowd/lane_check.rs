@@ -57,6 +57,19 @@ pub(super) fn operations_give_the_bits_of_f<T: Lane>() {
         assert!(same(x.abs().f(), a.abs()), "abs {a:?}");
         assert!(same(x.clamp01().f(), a.clamp01()), "clamp01 {a:?}");
         assert!(same(x.max(y).f(), a.max(b)), "max {a:?} {b:?}");
+        let (gt, lt) = (a.gt(b), a.lt(b));
+        assert!(
+            same(x.max_gt(y).f(), F::select(gt, a, b)),
+            "max_gt {a:?} {b:?}"
+        );
+        assert!(
+            same(x.min_lt(y).f(), F::select(lt, a, b)),
+            "min_lt {a:?} {b:?}"
+        );
+        assert!(
+            same(y.max_gt(x).f(), F::select(b.gt(a), b, a)),
+            "max_gt {b:?} {a:?}"
+        );
         assert!(same(x.signum().f(), F(a.0.map(f32::signum))));
         assert_eq!(x.lt(y).m(), a.lt(b), "{a:?} < {b:?}");
         assert_eq!(x.le(y).m(), a.le(b), "{a:?} <= {b:?}");

@@ -260,6 +260,18 @@ pub trait Lane:
     fn finite(self) -> Self::M;
     /// `m ? a : b` per lane.
     fn select(m: Self::M, a: Self, b: Self) -> Self;
+    /// `self > o ? self : o` per lane (glam's `max`: `o` where either is NaN, and of two
+    /// zeros), one instruction in the explicit types.
+    #[inline(always)]
+    fn max_gt(self, o: Self) -> Self {
+        Self::select(self.gt(o), self, o)
+    }
+    /// `self < o ? self : o` per lane (glam's `min`), one instruction in the explicit
+    /// types.
+    #[inline(always)]
+    fn min_lt(self, o: Self) -> Self {
+        Self::select(self.lt(o), self, o)
+    }
     /// `f32::clamp(self, 0, 1)` per lane.
     #[inline(always)]
     fn clamp01(self) -> Self {
