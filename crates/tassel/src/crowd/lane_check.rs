@@ -1,4 +1,4 @@
-//! Checks every explicit lane type (`crowd/avx.rs`, `crowd/avx512.rs`) runs: each
+//! The checks each explicit lane type (`crowd/avx.rs`, `crowd/avx512.rs`) runs: every
 //! operation against [`F`]'s, the reference, bit for bit.
 
 use super::lanes::{Lane, Mask, F, LANES, M};

@@ -260,7 +260,7 @@ pub trait Lane:
     fn finite(self) -> Self::M;
     /// `m ? a : b` per lane.
     fn select(m: Self::M, a: Self, b: Self) -> Self;
-    /// `self > o ? self : o` per lane (glam's `max`: `o` where either is NaN, and of two
+    /// `self > o ? self : o` per lane (glam's `max`: `o` where either is NaN or both are
     /// zeros), one instruction in the explicit types.
     #[inline(always)]
     fn max_gt(self, o: Self) -> Self {
