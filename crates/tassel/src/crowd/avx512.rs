@@ -22,8 +22,9 @@
 //! they are compiled inside those functions.
 #![allow(unsafe_code)]
 
-use super::lanes::{Lane, Mask, F, M};
+use super::lanes::{Lane, Mask, Trs, F, M, Q, V3};
 use super::Isa;
+use crate::math::Transform;
 use std::arch::x86_64::*;
 use std::ops::{Add, Div, Mul, Neg, Sub};
 
@@ -129,6 +130,47 @@ impl Lane for Fz {
         // SAFETY: see the module's documentation. Picks `a` where the lane's bit is set.
         Fz(unsafe { _mm512_mask_blend_ps(m.0, b.0, a.0) })
     }
+    /// Each transform's ten `f32` in one masked load (a row), then the 16×16
+    /// transposition of the rows: 64 shuffles where setting the lanes one by one takes
+    /// 160 scalar loads and stores (and the wide loads after them wait for those stores).
+    #[inline(always)]
+    fn transforms(ts: &[&Transform; 16]) -> Trs<Fz> {
+        // Where the fields lie, in `f32` (Rust chooses the order: asked, not assumed;
+        // glam's `Vec3` is `x, y, z` and its `Quat` `x, y, z, w`).
+        const T: usize = std::mem::offset_of!(Transform, translation) / 4;
+        const R: usize = std::mem::offset_of!(Transform, rotation) / 4;
+        const S: usize = std::mem::offset_of!(Transform, scale) / 4;
+        const _: () = assert!(T + 3 <= 16 && R + 4 <= 16 && S + 3 <= 16);
+        const _: () = assert!(std::mem::size_of::<Transform>() <= 64);
+        const MASK: u16 = (0b111 << T) | (0b1111 << R) | (0b111 << S);
+        // SAFETY: see the module's documentation. Each load reads only the masked
+        // elements, the ten `f32` of one `Transform` behind a reference (the padding
+        // and whatever follows are not read: masked-out elements are not accessed and
+        // cannot fault).
+        let mut rows = [unsafe { _mm512_setzero_ps() }; 16];
+        for (row, t) in rows.iter_mut().zip(ts) {
+            *row = unsafe { _mm512_maskz_loadu_ps(MASK, std::ptr::from_ref(*t).cast::<f32>()) };
+        }
+        let c = transpose(&rows).map(Fz);
+        Trs {
+            t: V3 {
+                x: c[T],
+                y: c[T + 1],
+                z: c[T + 2],
+            },
+            r: Q {
+                x: c[R],
+                y: c[R + 1],
+                z: c[R + 2],
+                w: c[R + 3],
+            },
+            s: V3 {
+                x: c[S],
+                y: c[S + 1],
+                z: c[S + 2],
+            },
+        }
+    }
     #[inline(always)]
     fn max_gt(self, o: Fz) -> Fz {
         // SAFETY: see the module's documentation. `vmaxps` is `a > b ? a : b` exactly
@@ -139,6 +181,84 @@ impl Lane for Fz {
     fn min_lt(self, o: Fz) -> Fz {
         // SAFETY: see the module's documentation. `vminps` is `a < b ? a : b` exactly.
         Fz(unsafe { _mm512_min_ps(self.0, o.0) })
+    }
+}
+
+/// The 16×16 transposition: element `l` of column `e` is element `e` of row `l`.
+/// Interleaves of 32-bit and 64-bit elements gather four rows' columns in each 128-bit
+/// block, then two shuffles of blocks put each column's four blocks together.
+#[inline(always)]
+fn transpose(r: &[__m512; 16]) -> [__m512; 16] {
+    // Rows 2i and 2i+1 interleaved: [2i] holds their columns 0, 1 (4, 5 in the next
+    // block, and so on), [2i+1] their columns 2, 3.
+    let mut t = [r[0]; 16];
+    for i in (0..16).step_by(2) {
+        t[i] = unpack(r[i], r[i + 1], false);
+        t[i + 1] = unpack(r[i], r[i + 1], true);
+    }
+    // Rows 4g..4g+4: [4g+k] holds column k of the four rows in block 0 (column 4b+k in
+    // block b).
+    let mut u = [r[0]; 16];
+    for g in (0..16).step_by(4) {
+        u[g] = unpack64(t[g], t[g + 2], false);
+        u[g + 1] = unpack64(t[g], t[g + 2], true);
+        u[g + 2] = unpack64(t[g + 1], t[g + 3], false);
+        u[g + 3] = unpack64(t[g + 1], t[g + 3], true);
+    }
+    // Column 4b+k: block b of u[k], u[4+k], u[8+k], u[12+k], in that order.
+    let mut c = [r[0]; 16];
+    for k in 0..4 {
+        let (v0, w0) = (
+            blocks(u[k], u[4 + k], false),
+            blocks(u[8 + k], u[12 + k], false),
+        );
+        let (v1, w1) = (
+            blocks(u[k], u[4 + k], true),
+            blocks(u[8 + k], u[12 + k], true),
+        );
+        c[k] = blocks(v0, w0, false);
+        c[8 + k] = blocks(v0, w0, true);
+        c[4 + k] = blocks(v1, w1, false);
+        c[12 + k] = blocks(v1, w1, true);
+    }
+    c
+}
+
+/// The 32-bit elements of `a` and `b` interleaved in each 128-bit block: the low two
+/// (`vunpcklps`) or the high two. (Functions, not closures: see `chain_step::select_max`.)
+#[inline(always)]
+fn unpack(a: __m512, b: __m512, high: bool) -> __m512 {
+    // SAFETY: see the module's documentation; register operations only.
+    unsafe {
+        match high {
+            false => _mm512_unpacklo_ps(a, b),
+            true => _mm512_unpackhi_ps(a, b),
+        }
+    }
+}
+
+/// [`unpack`] of 64-bit elements.
+#[inline(always)]
+fn unpack64(a: __m512, b: __m512, high: bool) -> __m512 {
+    // SAFETY: see the module's documentation; register operations only.
+    unsafe {
+        let (a, b) = (_mm512_castps_pd(a), _mm512_castps_pd(b));
+        _mm512_castpd_ps(match high {
+            false => _mm512_unpacklo_pd(a, b),
+            true => _mm512_unpackhi_pd(a, b),
+        })
+    }
+}
+
+/// The even 128-bit blocks (0, 2) of `a` then of `b`, or the odd ones (1, 3).
+#[inline(always)]
+fn blocks(a: __m512, b: __m512, odd: bool) -> __m512 {
+    // SAFETY: see the module's documentation; register operations only.
+    unsafe {
+        match odd {
+            false => _mm512_shuffle_f32x4::<0x88>(a, b),
+            true => _mm512_shuffle_f32x4::<0xDD>(a, b),
+        }
     }
 }
 
@@ -205,6 +325,11 @@ mod tests {
     #[test]
     fn avx512_lane_operations_give_the_bits_of_f() {
         with_avx512(lane_check::operations_give_the_bits_of_f::<Fz>);
+    }
+
+    #[test]
+    fn avx512_transforms_are_the_lanes_of_each() {
+        with_avx512(lane_check::transforms_are_the_lanes_of_each::<Fz>);
     }
 
     /// `several` is "more than one lane set", for every single lane and pair of lanes.

@@ -1040,17 +1040,16 @@ fn model_pose_lanes<T: Lane>(
     count: usize,
 ) -> (M, M) {
     let n = sk.len();
-    let root = Trs::<F>::splat(&Transform::IDENTITY);
     let mut bad = <T::M as Mask>::NONE;
     let mut sure = <T::M as Mask>::ALL;
     let max = T::splat(crate::limits::MAX_COORDINATE);
     for j in 0..n {
-        let mut local = root;
-        for l in 0..count {
-            local.set(l, &locals[l][j]);
-        }
-        s.lane_local_rotations[j] = local.r;
-        let local = Trs::<T>::of(&local);
+        let lane_locals = std::array::from_fn(|l| match l < count {
+            true => &locals[l][j],
+            false => &Transform::IDENTITY,
+        });
+        let local = T::transforms(&lane_locals);
+        s.lane_local_rotations[j] = local.r.f();
         let (t, sc) = (local.t.abs(), local.s.abs());
         let unit = (local.r.dot(local.r) - T::splat(1.0))
             .abs()

@@ -112,3 +112,27 @@ pub(super) fn several_means_more_than_one_lane<T: Lane>() {
         }
     }
 }
+
+/// [`Lane::transforms`] puts each transform's ten values in its own lane, each field in
+/// its place, with their bits (special values too), for several sets of transforms.
+pub(super) fn transforms_are_the_lanes_of_each<T: Lane>() {
+    use crate::math::Transform;
+    use glam::{Quat, Vec3};
+    let mut rng = Rng::new(0x7E57);
+    for _ in 0..200 {
+        let v: [F; 10] = std::array::from_fn(|_| values(&mut rng));
+        let ts: [Transform; LANES] = std::array::from_fn(|l| Transform {
+            translation: Vec3::new(v[0].0[l], v[1].0[l], v[2].0[l]),
+            rotation: Quat::from_xyzw(v[3].0[l], v[4].0[l], v[5].0[l], v[6].0[l]),
+            scale: Vec3::new(v[7].0[l], v[8].0[l], v[9].0[l]),
+        });
+        let refs: [&Transform; LANES] = std::array::from_fn(|l| &ts[l]);
+        let t = T::transforms(&refs);
+        let got = [
+            t.t.x, t.t.y, t.t.z, t.r.x, t.r.y, t.r.z, t.r.w, t.s.x, t.s.y, t.s.z,
+        ];
+        for (i, (g, want)) in got.iter().zip(v).enumerate() {
+            assert!(same(g.f(), want), "field {i}: {:?} for {want:?}", g.f());
+        }
+    }
+}

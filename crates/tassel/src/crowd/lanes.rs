@@ -300,6 +300,15 @@ pub trait Lane:
             }
         })))
     }
+    /// [`LANES`] transforms as lanes: lane `l` of the result is `ts[l]`.
+    #[inline(always)]
+    fn transforms(ts: &[&Transform; LANES]) -> Trs<Self> {
+        let mut t = Trs::<F>::splat(&Transform::IDENTITY);
+        for (l, x) in ts.iter().enumerate() {
+            t.set(l, x);
+        }
+        Trs::of(&t)
+    }
     /// Lane `i`.
     #[inline(always)]
     fn get(self, i: usize) -> f32 {
@@ -1420,6 +1429,12 @@ mod tests {
     /// The segment–segment closest parameters per lane against the scalar function, with
     /// every branch taken: general segments, parallel ones (denominator 0), each segment
     /// a point, both points, both clamps, NaN input.
+    #[test]
+    #[cfg(target_arch = "x86_64")]
+    fn portable_transforms_are_the_lanes_of_each() {
+        crate::crowd::lane_check::transforms_are_the_lanes_of_each::<F>();
+    }
+
     #[test]
     fn lane_segment_segment_gives_the_scalar_bits() {
         use crate::math::closest_params_segment_segment as scalar;

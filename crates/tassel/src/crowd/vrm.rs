@@ -766,18 +766,12 @@ impl Ctx<'_> {
         }
         let mut ok = <T::M as Mask>::of(M::from_bools(std::array::from_fn(|l| l >= used)));
         let mut all = <T::M as Mask>::NONE.not();
+        // Each slot's lanes in one transposition ([`Lane::transforms`]), checked as they
+        // come out of it.
         for (s, &j) in self.plan.joints.iter().enumerate() {
-            let locals = &mut scratch.locals[s];
-            for (lane, pose) in poses.iter().enumerate() {
-                locals.set(lane, &pose[j]);
-            }
-        }
-        // Checked in a pass of its own: a vector load right after the eight lane stores
-        // that wrote it waits for them to reach the cache (no store forwarding); checking
-        // each slot right after its transposition was 3.5 % slower (24.5 against 23.6 ns,
-        // `tassel bench --crowd 200 --vrm spec`, alternating runs).
-        for locals in &scratch.locals {
-            all = all.and(within_limits(&Trs::<T>::of(locals)));
+            let locals = T::transforms(&std::array::from_fn(|lane| &poses[lane][j]));
+            all = all.and(within_limits(&locals));
+            scratch.locals[s] = locals.f();
         }
         ok = ok.or(all);
         let mut fine = ok == <T::M as Mask>::ALL;
