@@ -284,6 +284,11 @@ mod tests {
         with_avx2(lane_check::operations_give_the_bits_of_f::<Fa>);
     }
 
+    #[test]
+    fn avx_transforms_are_the_lanes_of_each() {
+        with_avx2(lane_check::transforms_are_the_lanes_of_each::<Fa>);
+    }
+
     /// `several` is "more than one lane set", for every single lane and pair of lanes.
     #[test]
     fn several_means_more_than_one_lane() {

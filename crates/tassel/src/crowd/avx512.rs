@@ -143,12 +143,12 @@ impl Lane for Fz {
         const _: () = assert!(T + 3 <= 16 && R + 4 <= 16 && S + 3 <= 16);
         const _: () = assert!(std::mem::size_of::<Transform>() <= 64);
         const MASK: u16 = (0b111 << T) | (0b1111 << R) | (0b111 << S);
-        // SAFETY: see the module's documentation. Each load reads only the masked
-        // elements, the ten `f32` of one `Transform` behind a reference (the padding
-        // and whatever follows are not read: masked-out elements are not accessed and
-        // cannot fault).
-        let mut rows = [unsafe { _mm512_setzero_ps() }; 16];
+        let mut rows = [Fz::splat(0.0).0; 16];
         for (row, t) in rows.iter_mut().zip(ts) {
+            // SAFETY: see the module's documentation. The load reads only the masked
+            // elements, the ten `f32` of one `Transform` behind a reference (its padding
+            // and whatever follows it are not read: masked-out elements are not
+            // accessed and cannot fault).
             *row = unsafe { _mm512_maskz_loadu_ps(MASK, std::ptr::from_ref(*t).cast::<f32>()) };
         }
         let c = transpose(&rows).map(Fz);

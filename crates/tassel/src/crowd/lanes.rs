@@ -1426,15 +1426,17 @@ mod tests {
         }
     }
 
-    /// The segment–segment closest parameters per lane against the scalar function, with
-    /// every branch taken: general segments, parallel ones (denominator 0), each segment
-    /// a point, both points, both clamps, NaN input.
+    /// The portable type's [`Lane::transforms`] (the trait's own) puts each transform in
+    /// its lane.
     #[test]
     #[cfg(target_arch = "x86_64")]
     fn portable_transforms_are_the_lanes_of_each() {
         crate::crowd::lane_check::transforms_are_the_lanes_of_each::<F>();
     }
 
+    /// The segment–segment closest parameters per lane against the scalar function, with
+    /// every branch taken: general segments, parallel ones (denominator 0), each segment
+    /// a point, both points, both clamps, NaN input.
     #[test]
     fn lane_segment_segment_gives_the_scalar_bits() {
         use crate::math::closest_params_segment_segment as scalar;
