@@ -127,11 +127,11 @@ impl SpringIo<'_> {
     #[inline(always)]
     fn row_pose<T: Lane>(&self, row: &Row, d: usize, above: Trs<T>) -> (Trs<T>, Trs<T>) {
         let parent = if d == 0 {
-            Trs::<T>::of(&gather(self.models, &row.parent))
+            gather::<T>(self.models, &row.parent)
         } else {
             above
         };
-        (parent, Trs::<T>::of(&gather(self.locals, &row.joint)))
+        (parent, gather::<T>(self.locals, &row.joint))
     }
 }
 
@@ -651,14 +651,10 @@ impl Row {
     }
 }
 
-/// `transforms[index[l]]` in lane `l`.
+/// `transforms[index[l]]` in lane `l` ([`Lane::transforms`]).
 #[inline(always)]
-fn gather(transforms: &[Transform], index: &[usize; LANES]) -> Trs {
-    let mut t = Trs::splat(&Transform::IDENTITY);
-    for (l, &k) in index.iter().enumerate() {
-        t.set(l, &transforms[k]);
-    }
-    t
+fn gather<T: Lane>(transforms: &[Transform], index: &[usize; LANES]) -> Trs<T> {
+    T::transforms(&std::array::from_fn(|l| &transforms[index[l]]))
 }
 
 /// A scalar placed collider in every lane (with the bounding sphere of the crowd's quick
