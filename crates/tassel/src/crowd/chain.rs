@@ -13,7 +13,7 @@
 use super::avx::Fa;
 #[cfg(target_arch = "x86_64")]
 use super::avx512::Fz;
-use super::chain_step::{output_lanes, step_lanes, Bound, LaneShape, LaneStep};
+use super::chain_step::{output_lanes, step_lanes, Ahead, Bound, LaneShape, LaneStep, NO_AHEAD};
 use super::lanes::{rotation_arc, Lane, Mask, Trs, F, LANES, M, Q, V3};
 use super::{CrowdPose, Isa, SimdUse};
 use crate::collide::PlacedCollider;
@@ -163,23 +163,36 @@ impl Pack {
         ]
     }
 
-    /// Asks the processor to bring chain `ci`'s per-point state into its caches while
-    /// the work before it runs: a crowd larger than the caches otherwise waits for it
-    /// point by point (`tassel bench --crowd 10000 --threads 2`, with the teleport and
-    /// normals changes of the same commit: 24.0 -> 22.5 ms per frame). A hint only: no
-    /// effect on any value.
-    fn prefetch(&self, rig: &ChainRig, ci: usize) {
-        let points = rig.chains[ci].points.clone();
-        for field in [
+    /// This group's per-point state, as the group before it asks it into the caches while
+    /// it steps ([`Ahead`]).
+    fn ahead(&self) -> Ahead<'_> {
+        [
             &self.pos,
             &self.prev,
             &self.dev,
             &self.dev_before,
             &self.out,
             &self.prev_targets,
-        ] {
-            super::lanes::prefetch(&field[points.clone()]);
-        }
+        ]
+    }
+
+    /// Asks this group's per-chain and per-lane state into the second-level cache; called
+    /// while the group before it runs its frame (its per-point state that group's step
+    /// asks point by point, [`Ahead`], and its rotations that group's write-back asks
+    /// rotator by rotator). A crowd larger than the caches otherwise waits for each piece
+    /// where it is first read (`tassel bench --crowd 10000`). A hint only: no effect on
+    /// any value.
+    fn prefetch_frame_state(&self) {
+        use super::lanes::prefetch;
+        prefetch(&self.accumulator[..]);
+        prefetch(&self.dt_old[..]);
+        prefetch(&self.needs_reset[..]);
+        prefetch(&self.last_step_component[..]);
+        prefetch(&self.rng[..]);
+        prefetch(&self.paths[..]);
+        prefetch(std::slice::from_ref(&self.prev_component));
+        prefetch(&self.teleports[..]);
+        prefetch(&self.prev_colliders[..]);
     }
 
     fn lane(&mut self, l: usize) -> LaneState {
@@ -562,16 +575,18 @@ impl ChainCrowd {
             .zip(self.scratch[..chunks].par_iter_mut())
             .enumerate()
             .for_each(|(c, (packs, scratch))| {
-                for (k, pack) in packs.iter_mut().enumerate() {
-                    // The first chain's state, on its way while the model pose is computed
-                    // (each chain asks for the next one's: `run_chains`).
-                    if !ctx.rig.chains.is_empty() {
-                        pack.prefetch(ctx.rig, 0);
+                for k in 0..packs.len() {
+                    let (done, rest) = packs.split_at_mut(k + 1);
+                    let (pack, next) = (&mut done[k], rest.first());
+                    // The next group's state, on its way while this group runs (the step
+                    // and the write-back ask for the rest of it as they go).
+                    if let Some(next) = next {
+                        next.prefetch_frame_state();
                     }
                     let base = (c * chunk + k) * LANES;
                     pack.error = ctx.gather(pack, scratch, base, input).err();
                     if pack.error.is_none() {
-                        ctx.step(pack, scratch, true);
+                        ctx.step(pack, scratch, true, next);
                     }
                 }
             });
@@ -738,7 +753,7 @@ impl Twins {
             dt: frame.dt,
             isa: frame.isa,
         }
-        .step(pack, s, false);
+        .step(pack, s, false, None);
         for (l, start) in starts.enumerate() {
             for k in 0..n {
                 out[start + k] = pack.out[k].get(l);
@@ -1238,47 +1253,53 @@ impl Ctx<'_> {
     /// give the same bits.
     /// `write_back`: also the rotators' rotations per lane (a crowd's characters; twin
     /// chains have their own write-back).
-    fn step(&self, pack: &mut Pack, s: &mut Scratch, write_back: bool) {
+    fn step(&self, pack: &mut Pack, s: &mut Scratch, write_back: bool, next: Option<&Pack>) {
         // SAFETY (both): the function only requires the instructions of its lane type,
         // and `Isa::of` chose that type because the CPU has them.
         #[cfg(target_arch = "x86_64")]
         #[allow(unsafe_code)]
         match self.isa {
-            Isa::Avx512 => return unsafe { self.step_avx512(pack, s, write_back) },
-            Isa::Avx2 => return unsafe { self.step_avx2(pack, s, write_back) },
+            Isa::Avx512 => return unsafe { self.step_avx512(pack, s, write_back, next) },
+            Isa::Avx2 => return unsafe { self.step_avx2(pack, s, write_back, next) },
             Isa::Portable => {}
         }
-        self.step_lanes::<F>(pack, s, write_back)
+        self.step_lanes::<F>(pack, s, write_back, next)
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    fn step_avx2(&self, pack: &mut Pack, s: &mut Scratch, write_back: bool) {
+    fn step_avx2(&self, pack: &mut Pack, s: &mut Scratch, write_back: bool, next: Option<&Pack>) {
         // The explicit AVX2 lane type, only here after the CPU was found to have AVX2.
-        self.step_lanes::<Fa>(pack, s, write_back)
+        self.step_lanes::<Fa>(pack, s, write_back, next)
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512f,avx512dq,avx512vl,avx512bw")]
-    fn step_avx512(&self, pack: &mut Pack, s: &mut Scratch, write_back: bool) {
+    fn step_avx512(&self, pack: &mut Pack, s: &mut Scratch, write_back: bool, next: Option<&Pack>) {
         // The explicit AVX-512 lane type, only here after the CPU was found to have it.
-        self.step_lanes::<Fz>(pack, s, write_back)
+        self.step_lanes::<Fz>(pack, s, write_back, next)
     }
 
     /// One frame of one lane group whose input is in `scratch`; the solver steps
     /// computed in the lane type `T`.
     #[inline(always)]
-    fn step_lanes<T: Lane>(&self, pack: &mut Pack, s: &mut Scratch, write_back: bool) {
-        self.run_chains::<T>(pack, s);
+    fn step_lanes<T: Lane>(
+        &self,
+        pack: &mut Pack,
+        s: &mut Scratch,
+        write_back: bool,
+        next: Option<&Pack>,
+    ) {
+        self.run_chains::<T>(pack, s, next.map_or(NO_AHEAD, Pack::ahead));
         if write_back {
-            self.write_back(pack, s);
+            self.write_back(pack, s, next);
         }
     }
 
     /// Every chain of the rig for the group's lanes, up to their output points (no
     /// write-back).
     #[inline(always)]
-    fn run_chains<T: Lane>(&self, pack: &mut Pack, s: &mut Scratch) {
+    fn run_chains<T: Lane>(&self, pack: &mut Pack, s: &mut Scratch, ahead: Ahead) {
         let rig = self.rig;
         let live = M::from_bools(std::array::from_fn(|l| l < pack.count));
         for l in 0..pack.count {
@@ -1295,10 +1316,7 @@ impl Ctx<'_> {
             s.jump[l] = (moved, turned);
         }
         for ci in 0..rig.chains.len() {
-            if ci + 1 < rig.chains.len() {
-                pack.prefetch(rig, ci + 1);
-            }
-            self.run_chain::<T>(ci, pack, s, live);
+            self.run_chain::<T>(ci, pack, s, live, ahead);
         }
         pack.prev_targets.copy_from_slice(&s.targets);
         // The normals are read only by chains with a planar constraint.
@@ -1317,7 +1335,7 @@ impl Ctx<'_> {
     /// simulated children (mean direction) on top of its animated rotation; its local
     /// rotation is kept per lane.
     #[inline(always)]
-    fn write_back(&self, pack: &mut Pack, s: &mut Scratch) {
+    fn write_back(&self, pack: &mut Pack, s: &mut Scratch, next: Option<&Pack>) {
         let (sk, rig) = (self.sk, self.rig);
         // The animated model rotations (in the lanes not in use: of identity locals,
         // never read).
@@ -1333,7 +1351,13 @@ impl Ctx<'_> {
         // joint's animated one, so the processor overlaps the rotators' long chains of
         // roots and divisions), then every local rotation, which reads its parent's new
         // model rotation. The same operations on the same values.
-        for ((joint, point, kids), turn) in rig.rotators.iter().zip(&mut s.new_rotations) {
+        for (k, ((joint, point, kids), turn)) in
+            rig.rotators.iter().zip(&mut s.new_rotations).enumerate()
+        {
+            // The next group's rotation of this rotator, on its way (as `Ahead`).
+            if let Some(next) = next {
+                super::lanes::prefetch(&next.out_rotation[k..k + 1]);
+            }
             let (j, p) = (*joint as usize, *point as usize);
             let (mut anim, mut sim) = (zero, zero);
             for &c in &rig.rotator_children[kids.start as usize..kids.end as usize] {
@@ -1360,7 +1384,14 @@ impl Ctx<'_> {
     }
 
     #[inline(always)]
-    fn run_chain<T: Lane>(&self, ci: usize, pack: &mut Pack, s: &mut Scratch, live: M) {
+    fn run_chain<T: Lane>(
+        &self,
+        ci: usize,
+        pack: &mut Pack,
+        s: &mut Scratch,
+        live: M,
+        ahead: Ahead,
+    ) {
         let rig = self.rig;
         let set = &rig.chains[ci].settings;
         let points = rig.chains[ci].points.clone();
@@ -1384,8 +1415,8 @@ impl Ctx<'_> {
         let run = live.and(reset.not());
         if run.any() {
             match set.mode {
-                TimeMode::Classic => self.run_classic::<T>(ci, pack, s, run),
-                TimeMode::Fixed => self.run_fixed::<T>(ci, pack, s, run),
+                TimeMode::Classic => self.run_classic::<T>(ci, pack, s, run, ahead),
+                TimeMode::Fixed => self.run_fixed::<T>(ci, pack, s, run, ahead),
             }
         }
         // Guard: never let a non-finite value out; start again from the pose instead.
@@ -1474,6 +1505,7 @@ impl Ctx<'_> {
                     dt: h,
                     dt_old: F::splat(h),
                     active: m,
+                    ahead: NO_AHEAD,
                 };
                 step_lanes::<T>(
                     rig,
@@ -1499,7 +1531,14 @@ impl Ctx<'_> {
     }
 
     #[inline(always)]
-    fn run_classic<T: Lane>(&self, ci: usize, pack: &mut Pack, s: &mut Scratch, run: M) {
+    fn run_classic<T: Lane>(
+        &self,
+        ci: usize,
+        pack: &mut Pack,
+        s: &mut Scratch,
+        run: M,
+        ahead: Ahead,
+    ) {
         let rig = self.rig;
         let set = &rig.chains[ci].settings;
         let dt = self.dt.min(set.max_delta_time);
@@ -1529,6 +1568,7 @@ impl Ctx<'_> {
                 dt,
                 dt_old: pack.dt_old[ci],
                 active: run,
+                ahead,
             };
             step_lanes::<T>(
                 rig,
@@ -1549,7 +1589,14 @@ impl Ctx<'_> {
     }
 
     #[inline(always)]
-    fn run_fixed<T: Lane>(&self, ci: usize, pack: &mut Pack, s: &mut Scratch, run: M) {
+    fn run_fixed<T: Lane>(
+        &self,
+        ci: usize,
+        pack: &mut Pack,
+        s: &mut Scratch,
+        run: M,
+        ahead: Ahead,
+    ) {
         let rig = self.rig;
         let chain = &rig.chains[ci];
         let set = &chain.settings;
@@ -1683,6 +1730,7 @@ impl Ctx<'_> {
                 dt: h,
                 dt_old: F::splat(h),
                 active,
+                ahead,
             };
             step_lanes::<T>(
                 rig,

@@ -411,7 +411,21 @@ pub(super) struct LaneStep<'a> {
     pub dt_old: F,
     /// The lanes that take this step; the others are left as they are.
     pub active: M,
+    /// The next lane group's state, asked into the caches point by point as this one
+    /// steps ([`Ahead`]).
+    pub ahead: Ahead<'a>,
 }
+
+/// The next lane group's per-point state (its `pos`, `prev`, `dev`, `dev_before`, `out`
+/// and `prev_targets`): while a group steps point `p`, point `p` of each is asked into
+/// the second-level cache ([`super::lanes::prefetch`]), so that the next group finds its
+/// state there rather than in memory, a group's time ahead and spread evenly over the
+/// step (a crowd larger than the caches otherwise waits for it). Empty slices: no next
+/// group. A hint only: no effect on any value.
+pub(super) type Ahead<'a> = [&'a [V3]; 6];
+
+/// No next group ([`Ahead`]).
+pub(super) const NO_AHEAD: Ahead<'static> = [&[]; 6];
 
 /// glam's `Vec3::min` per lane (`a < b ? a : b`, glam's NaN rule).
 #[inline(always)]
@@ -629,6 +643,9 @@ pub(super) fn step_lanes<T: Lane>(
     let rotate_cs = Q::<T>::of(input.rotate_cs);
     let gravity_step = V3::<T>::of(input.gravity_step);
     for p in chain.points.clone() {
+        for field in input.ahead {
+            super::lanes::prefetch(field.get(p..p + 1).unwrap_or_default());
+        }
         let parent = rig.parent[p];
         let (pos_p, prev_p) = (V3::<T>::of(pos[p]), V3::<T>::of(prev[p]));
         if parent == NONE {

@@ -1320,13 +1320,13 @@ pub fn closest_params_segment_segment<T: Lane>(
     (s, t)
 }
 
-/// Asks the processor to bring `data` into its caches (a hint: it changes no value, and
-/// does nothing on targets without the instruction).
+/// Asks the processor to bring `data` into its second-level cache, every 64-byte line of
+/// it (a hint: it changes no value, and does nothing on targets without the instruction).
 #[inline]
 pub(super) fn prefetch<D>(data: &[D]) {
     #[cfg(target_arch = "x86_64")]
     {
-        use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+        use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T1};
         let bytes = std::mem::size_of_val(data);
         let start = data.as_ptr() as *const i8;
         for at in (0..bytes).step_by(64) {
@@ -1334,7 +1334,7 @@ pub(super) fn prefetch<D>(data: &[D]) {
             // the program (SSE, which every x86_64 has); `at` is inside `data` anyway.
             #[allow(unsafe_code)]
             unsafe {
-                _mm_prefetch::<_MM_HINT_T0>(start.add(at))
+                _mm_prefetch::<_MM_HINT_T1>(start.add(at))
             };
         }
     }
