@@ -1320,8 +1320,9 @@ pub fn closest_params_segment_segment<T: Lane>(
     (s, t)
 }
 
-/// Asks the processor to bring `data` into its second-level cache, every 64-byte line of
-/// it (a hint: it changes no value, and does nothing on targets without the instruction).
+/// Asks the processor to bring every 64-byte line of `data` into its second-level cache
+/// (the T1 hint; a hint only: it changes no value, and does nothing on targets without
+/// the instruction).
 #[inline]
 pub(super) fn prefetch<D>(data: &[D]) {
     #[cfg(target_arch = "x86_64")]
