@@ -164,7 +164,8 @@ impl Pack {
     }
 
     /// This group's per-point state, as the group before it asks it into the caches while
-    /// it steps ([`Ahead`]).
+    /// it steps ([`Ahead`]): [`Pack::point_fields`] but `prev_normals`, which only a
+    /// chain with a planar constraint reads.
     fn ahead(&self) -> Ahead<'_> {
         [
             &self.pos,
