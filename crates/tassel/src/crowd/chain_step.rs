@@ -492,7 +492,7 @@ fn near_sets<T: Lane>(
     }
 }
 
-/// [`NearSet::resolve`] for the `open` lanes: the members of the list in order, each asked
+/// [`crate::collide::NearSet::resolve`] for the `open` lanes: the members of the list in order, each asked
 /// for the lanes whose set holds it or whose point a member before it moved; and of
 /// those, only the lanes that [`PlacedCollider::resolve`]'s own quick rejection (both
 /// ends of the step beyond the shape's bounding sphere, the step too short to reach it)
