@@ -9,11 +9,43 @@ pub fn tassel() -> Command {
     Command::new(env!("CARGO_BIN_EXE_tassel"))
 }
 
-pub fn tmp(name: &str) -> PathBuf {
+/// A test's scratch folder (`<temp>/tassel-cli-<pid>-<name>`), made empty on creation and
+/// removed when the test is done with it; kept when the test panics, so that a failure's
+/// files can be looked at.
+pub struct Scratch(PathBuf);
+
+impl Drop for Scratch {
+    fn drop(&mut self) {
+        if !std::thread::panicking() {
+            let _ = std::fs::remove_dir_all(&self.0);
+        }
+    }
+}
+
+impl std::ops::Deref for Scratch {
+    type Target = Path;
+    fn deref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl AsRef<Path> for Scratch {
+    fn as_ref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl AsRef<std::ffi::OsStr> for Scratch {
+    fn as_ref(&self) -> &std::ffi::OsStr {
+        self.0.as_os_str()
+    }
+}
+
+pub fn tmp(name: &str) -> Scratch {
     let d = std::env::temp_dir().join(format!("tassel-cli-{}-{name}", std::process::id()));
     let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).unwrap();
-    d
+    Scratch(d)
 }
 
 pub fn testdata(rel: &str) -> Option<PathBuf> {
