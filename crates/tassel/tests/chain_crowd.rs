@@ -283,9 +283,10 @@ fn chain_crowd_rejects_bad_input_by_character() {
     assert!(crowd.write_pose(0, &mut short_locals, &mut models).is_err());
 }
 
-/// Characters removed mid-run (`swap_remove`, the last taking the index) and added again:
-/// everyone left carries on with the bits of their own `CharacterSim`, and a character
-/// added into a freed lane starts afresh.
+/// Characters swapped mid-run (`swap`: across lane groups and within one), removed
+/// (`swap_remove`, the last taking the index) and added again: everyone left carries on
+/// with the bits of their own `CharacterSim`, and a character added into a freed lane
+/// starts afresh.
 #[test]
 fn chain_crowd_removes_and_adds_characters() {
     let (sk, mut settings) = builtin::bench_character(6, 5, 8);
@@ -308,6 +309,13 @@ fn chain_crowd_removes_and_adds_characters() {
     let mut models = sk.rest().to_vec();
     let mut inputs = vec![(Transform::IDENTITY, sk.rest().to_vec()); 40];
     for f in 0..240 {
+        if f == 30 {
+            // Across lane groups, within one, and a character with itself.
+            for (a, b) in [(1, 17), (4, 6), (2, 2)] {
+                crowd.swap(a, b).unwrap();
+                sims.swap(a, b);
+            }
+        }
         if f == 60 {
             // Remove character 3 (the last takes its index), then the new last one.
             for gone in [3usize, 19] {
@@ -349,6 +357,7 @@ fn chain_crowd_removes_and_adds_characters() {
             }
         }
     }
+    assert!(crowd.swap(0, crowd.len()).is_err() && crowd.swap(crowd.len(), 0).is_err());
 }
 
 /// A pose whose every joint is within the input limits but whose model pose overflows

@@ -389,9 +389,10 @@ fn vrm_crowd_checks_every_joint_of_every_character() {
     assert_eq!(sk.name(extra), "extra");
 }
 
-/// Characters removed mid-run (`swap_remove`, the last taking the index) and added again:
-/// everyone left carries on with the bits of their own `CharacterSim`, and a character
-/// added into a freed lane starts afresh.
+/// Characters swapped mid-run (`swap`: across lane groups and within one), removed
+/// (`swap_remove`, the last taking the index) and added again: everyone left carries on
+/// with the bits of their own `CharacterSim`, and a character added into a freed lane
+/// starts afresh.
 #[test]
 fn vrm_crowd_removes_and_adds_characters() {
     let (sk, bones) = builtin::bench_vrm(6, 5, 8);
@@ -416,6 +417,13 @@ fn vrm_crowd_removes_and_adds_characters() {
         let (mut locals, mut models) = (sk.rest().to_vec(), sk.rest().to_vec());
         for f in 0..300 {
             match f {
+                60 => {
+                    // Across lane groups, within one, and a character with itself.
+                    for (a, b) in [(1, 16), (4, 6), (2, 2)] {
+                        crowd.swap(a, b).unwrap();
+                        people.swap(a, b);
+                    }
+                }
                 100 => {
                     for i in [3, 15, 0, 8] {
                         crowd.swap_remove(i).unwrap();
@@ -458,6 +466,7 @@ fn vrm_crowd_removes_and_adds_characters() {
             }
         }
         assert!(crowd.swap_remove(crowd.len()).is_err());
+        assert!(crowd.swap(0, crowd.len()).is_err() && crowd.swap(crowd.len(), 0).is_err());
         while !crowd.is_empty() {
             crowd.swap_remove(0).unwrap();
         }

@@ -436,6 +436,24 @@ impl ChainCrowd {
         Ok(())
     }
 
+    /// Swaps characters `i` and `j` (their indices; each carries on exactly as it would
+    /// have). Characters share a lane group [`LANES`] at a time, in index order, and a
+    /// group costs least when its characters move alike (the same clip near the same
+    /// time, the same contacts): the step runs each branch for all of a group's lanes
+    /// when any of them needs it. `tassel bench --crowd 192 --phase-step S` shows the
+    /// effect; see the README's speed section. Allocates (a few kilobytes).
+    pub fn swap(&mut self, i: usize, j: usize) -> Result<()> {
+        self.check(i)?;
+        self.check(j)?;
+        if i != j {
+            let a = self.packs[i / LANES].lane(i % LANES);
+            let b = self.packs[j / LANES].lane(j % LANES);
+            self.packs[i / LANES].set_lane(i % LANES, &b);
+            self.packs[j / LANES].set_lane(j % LANES, &a);
+        }
+        Ok(())
+    }
+
     /// Which lane code steps the crowd: the widest the CPU has ([`SimdUse::Auto`], the
     /// default: AVX-512, else AVX2, else portable), AVX2 at most ([`SimdUse::Avx2`]) or
     /// the portable code ([`SimdUse::Portable`]; the crowd has no scalar code of its own,
