@@ -32,6 +32,12 @@ pub struct Args {
     /// Threads sharing the crowd.
     #[arg(long, default_value_t = 1)]
     threads: usize,
+    /// With --crowd: character `i` runs the motion `i` times this many seconds ahead
+    /// (its phase). The default spreads neighbours far apart on the motion's 2.1 s
+    /// cycle; a small step makes the characters of each lane group move alike, which
+    /// the crowd path runs faster (`ChainCrowd::swap` lets a game group its characters).
+    #[arg(long, requires = "crowd", default_value_t = 0.37)]
+    phase_step: f32,
     /// With --crowd: also time the single-character path (one `CharacterSim` per
     /// character, the same threads) in the same run and print the ratio.
     #[arg(long, requires = "crowd")]
@@ -211,6 +217,12 @@ fn crowd(a: &Args, n: usize) -> Result<(), String> {
     if !(1..=256).contains(&a.threads) {
         return Err(format!("--threads {} must be 1..=256", a.threads));
     }
+    if !(a.phase_step.is_finite() && a.phase_step.abs() <= 1000.0) {
+        return Err(format!(
+            "--phase-step {} must be a number of seconds within ±1000",
+            a.phase_step
+        ));
+    }
     let threads = a.threads.min(n);
     let frames = a.frames.max(1);
     let crowd_path = !a.cloth;
@@ -248,7 +260,8 @@ fn crowd(a: &Args, n: usize) -> Result<(), String> {
         )
     };
     say!(
-        "tassel bench --crowd: {what}; {path}; median of {} runs x {frames} frames",
+        "tassel bench --crowd: {what}; {path}; character i at i x {} s on the motion; median of {} runs x {frames} frames",
+        a.phase_step,
         a.runs.max(1)
     );
     if let (true, Some((_, _, r))) = (crowd_path, &reference) {
@@ -286,7 +299,7 @@ fn chain_crowd(
     time_crowd(a, threads, frames, what, joints, |f| {
         crowd
             .frame(1.0 / 60.0, |i| CrowdPose {
-                transform: motion(f, i as f32 * 0.37),
+                transform: motion(f, i as f32 * a.phase_step),
                 locals: &rest,
             })
             .map_err(|e| e.to_string())
@@ -343,7 +356,7 @@ fn vrm_crowd(
     time_crowd(a, threads, frames, what, joints, |f| {
         crowd
             .frame(1.0 / 60.0, |i| CrowdPose {
-                transform: motion(f, i as f32 * 0.37),
+                transform: motion(f, i as f32 * a.phase_step),
                 locals: &rest,
             })
             .map_err(|e| e.to_string())
@@ -370,7 +383,7 @@ fn sims_crowd(
     }
     let rest = sims[0].skeleton().rest().to_vec();
     let batch = n.div_ceil(threads);
-    let dt = 1.0 / 60.0;
+    let (dt, phase_step) = (1.0 / 60.0, a.phase_step);
     let mut first_frame = 0usize;
     let mut one_run = |sims: &mut [CharacterSim], frames: usize| -> Result<f64, String> {
         let barrier = std::sync::Barrier::new(threads);
@@ -384,7 +397,7 @@ fn sims_crowd(
                     scope.spawn(move || -> Result<(), String> {
                         for f in first_frame..first_frame + frames {
                             for (k, sim) in chunk.iter_mut().enumerate() {
-                                let phase = (b * batch + k) as f32 * 0.37;
+                                let phase = (b * batch + k) as f32 * phase_step;
                                 sim.frame(rest, motion(f, phase), dt)
                                     .map_err(|e| e.to_string())?;
                             }

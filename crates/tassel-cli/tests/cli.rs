@@ -419,7 +419,7 @@ fn inspect_lists_vrm_springs_and_clips() {
 }
 
 /// `--crowd N --threads T` ends with the line the crowd figures are read from; `--cloth`
-/// times the built-in skirt's 32 free points; bad counts are refused.
+/// times the built-in skirt's 32 free points; bad counts and phase steps are refused.
 #[test]
 fn bench_crowd_and_cloth() {
     let out = tassel()
@@ -496,6 +496,8 @@ fn bench_crowd_and_cloth() {
     for bad in [
         &["--crowd", "0"][..],
         &["--crowd", "2", "--threads", "0"][..],
+        &["--crowd", "2", "--phase-step", "nan"][..],
+        &["--crowd", "2", "--phase-step", "1e9"][..],
     ] {
         let out = tassel().arg("bench").args(bad).output().unwrap();
         assert!(!out.status.success(), "{bad:?}");
