@@ -29,6 +29,25 @@ pub(crate) mod vrm_contact;
 pub use chain::ChainCrowd;
 pub use vrm::{CrowdPose, VrmCrowd};
 
+/// Swaps the characters in lanes `i` and `j` of a crowd's lane groups ([`lanes::LANES`]
+/// characters each, in index order): `take` copies one lane's state out, `put` writes
+/// it into a lane.
+fn swap_lanes<P, S>(
+    packs: &mut [P],
+    i: usize,
+    j: usize,
+    take: impl Fn(&mut P, usize) -> S,
+    put: impl Fn(&mut P, usize, &S),
+) {
+    use lanes::LANES;
+    if i != j {
+        let a = take(&mut packs[i / LANES], i % LANES);
+        let b = take(&mut packs[j / LANES], j % LANES);
+        put(&mut packs[i / LANES], i % LANES, &b);
+        put(&mut packs[j / LANES], j % LANES, &a);
+    }
+}
+
 /// Which code runs a solver step that has a lane path. Every choice gives the same bits
 /// (each lane repeats the scalar operations); they differ in speed only.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]

@@ -461,20 +461,15 @@ impl VrmCrowd {
     }
 
     /// Swaps characters `i` and `j` (their indices; each carries on exactly as it would
-    /// have). Characters share a lane group [`LANES`] at a time, in index order, and a
-    /// group costs least when its characters move alike (the same clip near the same
-    /// time, the same contacts): the step runs each branch for all of a group's lanes
-    /// when any of them needs it. `tassel bench --crowd 192 --phase-step S` shows the
-    /// effect; see the README's speed section. Allocates (a few kilobytes).
+    /// have). Characters share a lane group [`LANES`] at a time, in index order; which
+    /// ones share a group changes the VRM crowd's cost little (about 3 % between
+    /// characters that move alike and characters that do not, `tassel bench --vrm spec
+    /// --crowd 192 --phase-step S`), the chain crowd's much more
+    /// ([`super::ChainCrowd::swap`]). Allocates (both characters' state, briefly).
     pub fn swap(&mut self, i: usize, j: usize) -> Result<()> {
         self.check(i)?;
         self.check(j)?;
-        if i != j {
-            let a = self.packs[i / LANES].lane(i % LANES);
-            let b = self.packs[j / LANES].lane(j % LANES);
-            self.packs[i / LANES].set_lane(i % LANES, &b);
-            self.packs[j / LANES].set_lane(j % LANES, &a);
-        }
+        super::swap_lanes(&mut self.packs, i, j, |p, l| p.lane(l), Pack::set_lane);
         Ok(())
     }
 
