@@ -492,12 +492,13 @@ fn near_sets<T: Lane>(
     }
 }
 
-/// [`crate::collide::NearSet::resolve`] for the `open` lanes: the members of the list in order, each asked
-/// for the lanes whose set holds it or whose point a member before it moved; and of
-/// those, only the lanes that [`PlacedCollider::resolve`]'s own quick rejection (both
-/// ends of the step beyond the shape's bounding sphere, the step too short to reach it)
-/// and, for keep-out spheres and capsules, the narrow phase's own contact decision do not
-/// turn away, computed here for all lanes at once with their operations.
+/// [`crate::collide::NearSet::resolve`] for the `open` lanes: the members of the list in
+/// order, each asked for the lanes whose set holds it or whose point a member before it
+/// moved; and of those, only the lanes that [`PlacedCollider::resolve`]'s own quick
+/// rejection (both ends of the step beyond the shape's bounding sphere, the step too
+/// short to reach it) and, for keep-out spheres and capsules, the narrow phase's own
+/// contact decision do not turn away, computed here for all lanes at once with their
+/// operations.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 fn collide<T: Lane>(
