@@ -1176,6 +1176,102 @@ mod tests {
         );
     }
 
+    /// [`collide`] with a point's near sets ([`near_sets`] of the step's box) gives the
+    /// bits of asking every member of the list for every open lane: a member outside a
+    /// lane's set gives that lane's point back unchanged. Keep-out spheres, capsules (in
+    /// lanes) and boxes (scalar), clustered about the points so that many sets leave
+    /// members out and many points are pushed; swept steps and points at rest.
+    #[test]
+    fn collide_with_near_sets_gives_the_bits_of_asking_every_member() {
+        let mut rng = SplitMix64::new(17);
+        let mut u = |lo: f32, hi: f32| rng.range_f32(lo, hi);
+        let bits = |v: V3| [v.x, v.y, v.z].map(|c| c.0.map(f32::to_bits));
+        let m = 8;
+        let list: Vec<usize> = (0..m).collect();
+        // Lanes whose set leaves a member out, and lanes a member moved.
+        let (mut left_out, mut moved_lanes) = (0, 0);
+        for round in 0..2000 {
+            let shapes: Vec<Shape> = (0..m)
+                .map(|k| match (round + k) % 3 {
+                    0 => Shape::Sphere {
+                        radius: u(0.02, 0.08),
+                        inside: false,
+                    },
+                    1 => Shape::Capsule {
+                        radius: u(0.02, 0.06),
+                        length: u(0.0, 0.2),
+                    },
+                    _ => Shape::Box {
+                        half_extents: Vec3::new(u(0.01, 0.05), u(0.01, 0.05), u(0.01, 0.05)),
+                    },
+                })
+                .collect();
+            let lane_shapes: Vec<LaneShape> = shapes.iter().map(|&sh| LaneShape::of(sh)).collect();
+            let mut colliders = Vec::with_capacity(m * LANES);
+            let mut bounds = vec![Bound::ZERO; m];
+            let (mut start, mut x, mut lo, mut hi) = (V3::ZERO, V3::ZERO, V3::ZERO, V3::ZERO);
+            let r = u(0.0, 0.03);
+            for l in 0..LANES {
+                let parent = Vec3::new(u(-1.0, 1.0), u(-1.0, 1.0), u(-1.0, 1.0));
+                let length = u(0.03, 0.12);
+                let dir = Vec3::new(u(-1.0, 1.0), u(-1.0, 1.0), u(-1.0, 1.0)).normalize_or(Vec3::Y);
+                let s0 = parent + dir * length;
+                let x0 = s0 + Vec3::new(u(-0.03, 0.03), u(-0.03, 0.03), u(-0.03, 0.03));
+                for (k, &shape) in shapes.iter().enumerate() {
+                    // Most colliders about the bone, some far from it.
+                    let spread = if k % 4 == 3 { 0.6 } else { 0.15 };
+                    let centre =
+                        s0 + Vec3::new(u(-spread, spread), u(-spread, spread), u(-spread, spread));
+                    let rotation =
+                        Quat::from_euler(glam::EulerRot::XYZ, u(-3.0, 3.0), u(-3.0, 3.0), 0.0);
+                    let pc = PlacedCollider {
+                        shape,
+                        transform: Transform::from_translation_rotation(centre, rotation),
+                    };
+                    bounds[k].set(l, &pc);
+                    colliders.push(pc);
+                }
+                start.set(l, s0);
+                x.set(l, x0);
+                lo.set(l, s0.min(x0).min(parent - length));
+                hi.set(l, s0.max(x0).max(parent + length));
+            }
+            let mut near = vec![M::NONE; m];
+            near_sets::<F>(&list, &bounds, lo, hi, r, &mut near);
+            let every = vec![M::ALL; m];
+            for prev in [Some(start), None] {
+                let open = M::from_bools(std::array::from_fn(|l| (l + round) % 7 != 0));
+                let run = |near: &[M]| {
+                    collide::<F>(
+                        &list,
+                        &colliders,
+                        m,
+                        &bounds,
+                        &lane_shapes,
+                        near,
+                        x,
+                        prev,
+                        r,
+                        open,
+                    )
+                };
+                let (y, moved) = run(&near);
+                let (y_all, moved_all) = run(&every);
+                assert_eq!(bits(y), bits(y_all), "round {round}, prev {prev:?}");
+                assert_eq!(moved.0, moved_all.0, "round {round}");
+                for l in 0..LANES {
+                    moved_lanes += usize::from(moved.0[l] != 0);
+                    left_out += usize::from(open.0[l] != 0 && near.iter().any(|n| n.0[l] == 0));
+                }
+            }
+        }
+        assert!(moved_lanes > 10_000, "{moved_lanes} lanes moved");
+        assert!(
+            left_out > 25_000,
+            "{left_out} lanes whose set left a member out"
+        );
+    }
+
     /// [`capsule_contact`] or [`sphere_contact`] in the AVX2 lane type, back in `F`/`M`.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
