@@ -283,9 +283,9 @@ impl CharacterSim {
 
     /// Which code runs the solvers that have a SIMD lane path (the VRM springs' update,
     /// the twin bone chains, [`ChainRig::lane_groups`], and the cloths' contact tests and
-    /// constraint order): lanes by default, [`crate::crowd::SimdUse::Scalar`] for the
+    /// constraint order): lanes by default, [`crate::lanes::SimdUse::Scalar`] for the
     /// readable reference. Every choice gives the same bits.
-    pub fn set_simd(&mut self, simd: crate::crowd::SimdUse) {
+    pub fn set_simd(&mut self, simd: crate::lanes::SimdUse) {
         self.vrm_state.set_simd(simd);
         self.state.set_simd(simd);
         self.cloth_state.set_simd(simd);

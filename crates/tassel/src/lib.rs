@@ -13,6 +13,15 @@
 //!   [`dynamics::chain::ChainState`], [`dynamics::chain::ChainJob`]: bone chains.
 //! - [`collide`]: collider shapes and point queries.
 //! - [`builtin`]: an embedded demo character with procedural clips.
+//! - [`crowd::VrmCrowd`], [`crowd::ChainCrowd`]: many characters of one kind advanced
+//!   together, bit for bit as [`CharacterSim`] would advance each.
+//! - [`lanes`]: the SIMD lane types below the solvers ([`lanes::SimdUse`] chooses the
+//!   code that runs; every choice gives the same bits).
+//!
+//! Layers, lowest first: [`math`] and [`limits`] → [`lanes`] → [`collide`], [`anim`],
+//! [`controller`] → each solver in [`dynamics`] (its readable scalar step and its lane
+//! step side by side) → the character ([`CharacterRig`], [`CharacterSim`]) → [`crowd`].
+//! A lower layer never imports a higher one.
 //!
 //! The core does no file I/O.
 //!
@@ -39,6 +48,7 @@ pub mod crowd;
 pub mod dynamics;
 mod error;
 mod instance;
+pub mod lanes;
 pub mod limits;
 pub mod math;
 mod pose;
@@ -53,5 +63,5 @@ pub use error::{Error, Result};
 pub use glam;
 pub use instance::CharacterSim;
 pub use math::Transform;
-pub use pose::{LocalToModelJob, ModelToLocalJob, Pose};
+pub use pose::{CrowdPose, LocalToModelJob, ModelToLocalJob, Pose};
 pub use skeleton::{Skeleton, SkeletonBuilder, MAX_JOINTS, NO_PARENT};

@@ -94,6 +94,16 @@ fn check_len(what: &'static str, expected: usize, got: usize) -> Result<()> {
     }
 }
 
+/// One character's input for a crowd's frame ([`crate::crowd`]): where it is and its
+/// animated pose.
+#[derive(Debug, Clone, Copy)]
+pub struct CrowdPose<'a> {
+    /// The character's world transform this frame.
+    pub transform: Transform,
+    /// Its animated local transforms (one per skeleton joint).
+    pub locals: &'a [Transform],
+}
+
 /// Local → model: each joint's model transform is its parent's times its local one.
 #[derive(Debug)]
 pub struct LocalToModelJob<'a> {

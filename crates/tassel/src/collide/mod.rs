@@ -5,6 +5,8 @@
 
 mod r#box;
 mod capsule;
+pub(crate) mod entry_lanes;
+pub(crate) mod lanes;
 mod plane;
 mod sphere;
 

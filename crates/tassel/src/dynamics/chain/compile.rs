@@ -50,8 +50,8 @@ pub struct ChainRig {
     // Write-back: joints that turn toward their simulated children, in joint order.
     pub(crate) rotators: Vec<(u16, u32, Range<u32>)>,
     pub(crate) rotator_children: Vec<u32>,
-    /// Twin chains stepped side by side in SIMD lanes (see [`crate::crowd::chain_lanes`]).
-    pub(crate) lane_groups: Vec<crate::crowd::chain_lanes::ChainLaneGroup>,
+    /// Twin chains stepped side by side in SIMD lanes (see [`crate::dynamics::chain::lanes::twins`]).
+    pub(crate) lane_groups: Vec<crate::dynamics::chain::lanes::twins::ChainLaneGroup>,
     /// The rotators not written back in a lane group's lanes (with the lanes on), in
     /// order.
     pub(crate) scalar_rotators: Vec<u32>,
@@ -245,7 +245,7 @@ impl ChainRig {
                 .push((j, p, s..out.rotator_children.len() as u32));
         }
         let parents: Vec<Option<usize>> = (0..skeleton.len()).map(|j| skeleton.parent(j)).collect();
-        out.lane_groups = crate::crowd::chain_lanes::plan(&parents, &out);
+        out.lane_groups = crate::dynamics::chain::lanes::twins::plan(&parents, &out);
         out.chain_in_lanes = vec![false; out.chains.len()];
         for &ci in out.lane_groups.iter().flat_map(|g| &g.chains) {
             out.chain_in_lanes[ci] = true;

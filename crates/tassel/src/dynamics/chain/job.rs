@@ -5,11 +5,11 @@ use super::settings::TimeMode;
 use super::step::{step_chain, StepInput};
 use crate::collide::{NearSet, PlacedCollider};
 use crate::controller::Level;
-use crate::crowd::chain_lanes::{ChainLanes, LaneFrame, ScalarChains};
-use crate::crowd::{Isa, SimdUse};
+use crate::dynamics::chain::lanes::twins::{ChainLanes, LaneFrame, ScalarChains};
 use crate::dynamics::path::CharacterPath;
 use crate::dynamics::world::{push_out, WorldContact};
 use crate::error::{Error, Result};
+use crate::lanes::{Isa, SimdUse};
 use crate::math::{normalize_or, rotation_arc, Transform};
 use crate::rng::SplitMix64;
 use crate::skeleton::Skeleton;
@@ -58,7 +58,7 @@ pub struct ChainState {
     lanes: Vec<ChainLanes>,
     in_lanes: bool,
     /// Scratch of the lanes' write-back: each rotator row between its two passes.
-    turned: Vec<crate::crowd::chain_lanes::TurnedRow>,
+    turned: Vec<crate::dynamics::chain::lanes::twins::TurnedRow>,
 }
 
 impl ChainState {

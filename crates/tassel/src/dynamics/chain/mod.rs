@@ -8,6 +8,7 @@
 
 pub(crate) mod compile;
 pub(crate) mod job;
+pub(crate) mod lanes;
 mod settings;
 pub(crate) mod step;
 

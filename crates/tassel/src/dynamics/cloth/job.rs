@@ -2,13 +2,13 @@
 
 use super::compile::{ClothRig, ConstraintKind, Relaxed};
 use super::contact::{push_segment, push_triangle_against, Core};
+use super::lanes::{self as cloth_lanes, ClothLaneScratch};
 use crate::collide::PlacedCollider;
 use crate::controller::Level;
-use crate::crowd::cloth_lanes::{self, ClothLaneScratch};
-use crate::crowd::{Isa, SimdUse};
 use crate::dynamics::path::CharacterPath;
 use crate::dynamics::world::collide_points;
 use crate::error::{Error, Result};
+use crate::lanes::{Isa, SimdUse};
 use crate::math::{normalize_or, rotation_arc, Transform};
 use crate::rng::SplitMix64;
 use crate::skeleton::Skeleton;
@@ -518,7 +518,7 @@ fn relax(c: &Relaxed, pos: &mut [Vec3]) {
 }
 
 /// [`collide`] by the code `simd` chooses: the scalar reference itself, or the same
-/// tests in lanes (`crowd/cloth_lanes.rs`), which give its bits.
+/// tests in lanes (`dynamics/cloth/lanes.rs`), which give its bits.
 #[allow(clippy::too_many_arguments)]
 fn collide_with(
     simd: SimdUse,

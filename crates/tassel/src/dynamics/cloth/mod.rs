@@ -12,6 +12,7 @@
 pub(crate) mod compile;
 pub(crate) mod contact;
 mod job;
+pub(crate) mod lanes;
 mod settings;
 
 pub use compile::{ClothConstraint, ClothRig, ConstraintKind};

@@ -61,7 +61,7 @@ pub struct VrmRig {
     /// The file's node constraints, in evaluation order.
     pub(crate) constraints: super::constraint::CompiledConstraints,
     /// The links as SIMD lane rows (several springs side by side), where the rig allows.
-    pub(crate) lanes: Option<crate::crowd::spring_lanes::SpringLanes>,
+    pub(crate) lanes: Option<crate::dynamics::vrm::lanes::springs::SpringLanes>,
     joint_count: usize,
 }
 
@@ -125,7 +125,7 @@ impl VrmRig {
             lanes: None,
             joint_count: skeleton.len(),
         };
-        rig.lanes = crate::crowd::spring_lanes::SpringLanes::new(skeleton, &rig);
+        rig.lanes = crate::dynamics::vrm::lanes::springs::SpringLanes::new(skeleton, &rig);
         Ok(rig)
     }
 
@@ -142,14 +142,14 @@ impl VrmRig {
         self.lanes.as_ref().map_or(0, |l| l.groups())
     }
 
-    /// The lane plan when the job runs it (`simd` not [`crate::crowd::SimdUse::Scalar`])
+    /// The lane plan when the job runs it (`simd` not [`crate::lanes::SimdUse::Scalar`])
     /// and no node constraint runs before it: then the job reads, of the models it is
     /// given, only those of the plan's input joints (`SpringLanes::compose_input`).
     pub(crate) fn lanes_for(
         &self,
-        simd: crate::crowd::SimdUse,
-    ) -> Option<&crate::crowd::spring_lanes::SpringLanes> {
-        let runs = simd != crate::crowd::SimdUse::Scalar && self.constraints.list.is_empty();
+        simd: crate::lanes::SimdUse,
+    ) -> Option<&crate::dynamics::vrm::lanes::springs::SpringLanes> {
+        let runs = simd != crate::lanes::SimdUse::Scalar && self.constraints.list.is_empty();
         self.lanes.as_ref().filter(|_| runs)
     }
 

@@ -3,12 +3,12 @@
 
 use super::collide::PlacedVrmCollider;
 use super::compile::{VrmLink, VrmRig};
+use super::lanes::contact::Placed;
 use super::settings::VrmMode;
-use crate::crowd::spring_lanes::{SpringIo, SpringLanes};
-use crate::crowd::vrm_contact::Placed;
-use crate::crowd::{Isa, SimdUse};
 use crate::dynamics::path::CharacterPath;
+use crate::dynamics::vrm::lanes::springs::{SpringIo, SpringLanes};
 use crate::error::{Error, Result};
+use crate::lanes::{Isa, SimdUse};
 use crate::math::{normalize_or, rotation_arc, slerp_shortest, Transform};
 use crate::skeleton::Skeleton;
 use glam::{Quat, Vec3};
@@ -364,7 +364,7 @@ fn collide_output(
     models: &mut [Transform],
 ) {
     if let Some(lanes) = lane_plan(rig, state) {
-        // The same results, several springs at a time (`crowd/spring_lanes.rs`), which
+        // The same results, several springs at a time (`dynamics/vrm/lanes/springs.rs`), which
         // also turn the links to their output rotations (`w`).
         let isa = Isa::of(state.simd);
         let mut io = state.lane_io(component, 0.0, VrmMode::Fixed, locals, models);
@@ -478,7 +478,7 @@ fn update(
     models: &mut [Transform],
 ) -> bool {
     if let Some(lanes) = lane_plan(rig, state) {
-        // The same results, several springs at a time (`crowd/spring_lanes.rs`); the
+        // The same results, several springs at a time (`dynamics/vrm/lanes/springs.rs`); the
         // models of joints that are not links are left stale: every caller recomputes
         // the whole model pose before reading them.
         let isa = Isa::of(state.simd);

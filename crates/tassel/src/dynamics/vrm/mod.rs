@@ -55,6 +55,7 @@ mod collide;
 mod compile;
 mod constraint;
 mod job;
+pub(crate) mod lanes;
 mod settings;
 
 pub use collide::PlacedVrmCollider;

@@ -1,7 +1,7 @@
-//! The checks each explicit lane type (`crowd/avx.rs`, `crowd/avx512.rs`) runs: every
+//! The checks each explicit lane type (`lanes/avx.rs`, `lanes/avx512.rs`) runs: every
 //! operation against [`F`]'s, the reference, bit for bit.
 
-use super::lanes::{Lane, Mask, F, LANES, M};
+use super::{Lane, Mask, F, LANES, M};
 use crate::rng::SplitMix64 as Rng;
 
 fn same(a: F, b: F) -> bool {

@@ -1,5 +1,5 @@
-//! Lane types for the crowd path: one `f32` per character, [`LANES`] characters side by
-//! side, so that one instruction advances several characters.
+//! The lane types: one `f32` per lane (a character of a crowd, a chain or spring of one
+//! character), [`LANES`] lanes side by side, so that one instruction advances several.
 //!
 //! Every operation repeats, lane by lane, the exact sequence of IEEE operations that glam
 //! 0.32 (SSE2 build) and [`crate::math`] perform for one character: the same products,
@@ -8,9 +8,9 @@
 //!
 //! [`V3`], [`Q`] and [`Trs`] are generic over their per-lane type ([`Lane`]): [`F`],
 //! whose per-element loops are left to the compiler to vectorise (plain stable Rust,
-//! every target), and on x86_64 the crowd's private explicit types, used inside the
-//! crowds' AVX-512 and AVX2 functions only: `crowd/avx512.rs` (one 512-bit instruction per
-//! operation) and `crowd/avx.rs` (two 256-bit ones). [`crate::crowd::Isa::of`] chooses
+//! every target), and on x86_64 the private explicit types, used inside the lane
+//! steps' AVX-512 and AVX2 functions only: `lanes/avx512.rs` (one 512-bit instruction per
+//! operation) and `lanes/avx.rs` (two 256-bit ones). [`crate::lanes::Isa::of`] chooses
 //! at run time. State stays in [`F`]; `of` and `f` convert (the same bytes).
 
 use crate::math::Transform;
@@ -18,7 +18,7 @@ use glam::{Quat, Vec3};
 use std::ops::{Add, Div, Mul, Neg, Sub};
 
 /// Characters per lane group: 16 on x86_64, where one AVX-512 register holds them (a CPU
-/// with AVX2 only takes them in two registers, `crowd/avx.rs`), 8 elsewhere (the
+/// with AVX2 only takes them in two registers, `lanes/avx.rs`), 8 elsewhere (the
 /// portable lane type over arrays, which the compiler splits into the target's vectors:
 /// sixteen would need more registers than SSE or NEON have, measured 1.4x slower on
 /// x86_64 without AVX).
@@ -1064,7 +1064,7 @@ fn is_negative<T: Lane>(x: T) -> T::M {
 #[inline(always)]
 fn sin_approx<T: Lane>(v: T) -> T {
     let c = T::splat;
-    // (A function, not a closure: see `chain_step::select_max`.)
+    // (A function, not a closure: see `collide::lanes::select_max`.)
     let negative = is_negative::<T>;
     // m128_mod_angles: v − 2π·round(v / 2π), rounding by the 2^23 trick.
     let q = v * c(0.159_154_94);
@@ -1173,6 +1173,26 @@ impl<T: Lane> V3<T> {
     }
 }
 
+/// glam's `Vec3::min` per lane (`a < b ? a : b`, glam's NaN rule).
+#[inline(always)]
+pub(crate) fn vmin<T: Lane>(a: V3<T>, b: V3<T>) -> V3<T> {
+    V3 {
+        x: a.x.min_lt(b.x),
+        y: a.y.min_lt(b.y),
+        z: a.z.min_lt(b.z),
+    }
+}
+
+/// glam's `Vec3::max` per lane (`a > b ? a : b`).
+#[inline(always)]
+pub(crate) fn vmax<T: Lane>(a: V3<T>, b: V3<T>) -> V3<T> {
+    V3 {
+        x: a.x.max_gt(b.x),
+        y: a.y.max_gt(b.y),
+        z: a.z.max_gt(b.z),
+    }
+}
+
 /// `out[k] = a[k].lerp(&b[k], t)` for every `k` in `joints` ([`Transform::lerp`]'s bits),
 /// [`LANES`] at a time, in the lane type `isa` chose.
 pub(crate) fn lerp_transforms_at(
@@ -1208,7 +1228,7 @@ fn lerp_transforms_at_avx2(
     out: &mut [Transform],
 ) {
     // The explicit AVX2 lane type only inside this function, after the CPU was found to
-    // have AVX2 (the condition of its soundness, `crowd/avx.rs`).
+    // have AVX2 (the condition of its soundness, `lanes/avx.rs`).
     lerp_transforms_at_lanes::<super::avx::Fa>(a, b, t, joints, out)
 }
 
@@ -1222,7 +1242,7 @@ fn lerp_transforms_at_avx512(
     out: &mut [Transform],
 ) {
     // The explicit AVX-512 lane type only inside this function, after the CPU was found
-    // to have it (the condition of its soundness, `crowd/avx512.rs`).
+    // to have it (the condition of its soundness, `lanes/avx512.rs`).
     lerp_transforms_at_lanes::<super::avx512::Fz>(a, b, t, joints, out)
 }
 
@@ -1324,7 +1344,7 @@ pub fn closest_params_segment_segment<T: Lane>(
 /// (the T1 hint; a hint only: it changes no value, and does nothing on targets without
 /// the instruction).
 #[inline]
-pub(super) fn prefetch<D>(data: &[D]) {
+pub(crate) fn prefetch<D>(data: &[D]) {
     #[cfg(target_arch = "x86_64")]
     {
         use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T1};
@@ -1432,7 +1452,7 @@ mod tests {
     #[test]
     #[cfg(target_arch = "x86_64")]
     fn portable_transforms_are_the_lanes_of_each() {
-        crate::crowd::lane_check::transforms_are_the_lanes_of_each::<F>();
+        crate::lanes::check::transforms_are_the_lanes_of_each::<F>();
     }
 
     /// The segment–segment closest parameters per lane against the scalar function, with

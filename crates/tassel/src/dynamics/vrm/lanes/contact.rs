@@ -1,10 +1,10 @@
 //! The VRM specification's collision per lane: [`crate::dynamics::vrm::PlacedVrmCollider`]'s
 //! distance, push and settling with its operations, so that every lane gets the scalar
 //! bits. Shared by [`super::VrmCrowd`] (a lane per character) and the single character's
-//! springs side by side ([`super::spring_lanes`]).
+//! springs side by side ([`super::springs`]).
 
-use super::lanes::{closest_point_on_segment, differs, Lane, Mask, F, V3};
 use crate::dynamics::vrm::VrmShape;
+use crate::lanes::{closest_point_on_segment, differs, Lane, Mask, F, V3};
 use glam::Vec3;
 
 /// A collider placed in world space, per lane: `a` (centre, capsule head, plane point) and

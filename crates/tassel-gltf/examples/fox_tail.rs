@@ -2,7 +2,7 @@
 //! tip read by the chain's name.
 //!
 //! ```text
-//! cargo run --release -p tassel-gltf --example fox
+//! cargo run --release -p tassel-gltf --example fox_tail
 //! ```
 //! Reads `../shared/testdata/gltf/Fox.glb` (beside the clone) and `examples/rigs/fox.toml`.
 

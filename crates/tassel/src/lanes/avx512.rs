@@ -1,9 +1,9 @@
-//! The crowd's AVX-512 lane type: [`Fz`], one `__m512` per [`F`], every operation one
+//! The AVX-512 lane type: [`Fz`], one `__m512` per [`F`], every operation one
 //! 512-bit instruction, its conditions ([`Mz`]) one bit per lane in a mask register.
 //!
 //! Why it exists: on a CPU with AVX-512 (this project's 2-core AMD EPYC has it, at full
 //! width), one instruction advances all sixteen lanes of a group where the AVX2 type
-//! (`crowd/avx.rs`) needs two; conditions live in mask registers, so `select` is one
+//! (`lanes/avx.rs`) needs two; conditions live in mask registers, so `select` is one
 //! blend and `any` one test of a general register.
 //!
 //! Each operation is the IEEE operation per lane that [`F`]'s is (add, subtract,
@@ -12,18 +12,18 @@
 //! the same bits; `tests` checks it operation by operation.
 //!
 //! **Soundness.** The intrinsics need AVX-512 (F, and DQ/VL/BW enabled alongside). [`Fz`]
-//! and [`Mz`] are private to the crowd and only ever created inside functions compiled
+//! and [`Mz`] are private to the crate and only ever created inside functions compiled
 //! with `#[target_feature(enable = "avx512f,avx512dq,avx512vl,avx512bw")]` that are
-//! called where [`crate::crowd::Isa::of`] said [`crate::crowd::Isa::Avx512`], which it
+//! called where [`crate::lanes::Isa::of`] said [`crate::lanes::Isa::Avx512`], which it
 //! says only after `is_x86_feature_detected!` found all four (the `*_avx512` functions
-//! beside each `*_avx2` one; `entry_avx512` in `entry_lanes.rs`, called only where an
+//! beside each `*_avx2` one; `entry_avx512` in `collide/entry_lanes.rs`, called only where an
 //! [`Fz`] exists already; the tests below check the same first), so no AVX-512
 //! instruction runs on a CPU without it. The operations are `#[inline(always)]` so that
 //! they are compiled inside those functions.
 #![allow(unsafe_code)]
 
-use super::lanes::{Lane, Mask, Trs, F, M, Q, V3};
 use super::Isa;
+use super::{Lane, Mask, Trs, F, M, Q, V3};
 use crate::math::Transform;
 use std::arch::x86_64::*;
 use std::ops::{Add, Div, Mul, Neg, Sub};
@@ -225,7 +225,7 @@ fn transpose(r: &[__m512; 16]) -> [__m512; 16] {
 }
 
 /// The 32-bit elements of `a` and `b` interleaved in each 128-bit block: the low two
-/// (`vunpcklps`) or the high two. (Functions, not closures: see `chain_step::select_max`.)
+/// (`vunpcklps`) or the high two. (Functions, not closures: see `collide::lanes::select_max`.)
 #[inline(always)]
 fn unpack(a: __m512, b: __m512, high: bool) -> __m512 {
     // SAFETY: see the module's documentation; register operations only.
@@ -311,11 +311,11 @@ impl Mask for Mz {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::crowd::lane_check;
+    use crate::lanes::check as lane_check;
 
     /// Runs `f` only where the CPU has AVX-512 (the type's precondition), saying so else.
     fn with_avx512(f: impl FnOnce()) {
-        if Isa::of(crate::crowd::SimdUse::Auto) == Isa::Avx512 {
+        if Isa::of(crate::lanes::SimdUse::Auto) == Isa::Avx512 {
             f()
         } else {
             eprintln!("skipped: this CPU has no AVX-512, the AVX-512 lane type cannot run here");

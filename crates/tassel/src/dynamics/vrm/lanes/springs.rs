@@ -20,14 +20,14 @@
 //! between the first and the last link (the scalar refresh takes a root's local as its
 //! model there, the pose jobs compose it under the identity).
 
-#[cfg(target_arch = "x86_64")]
-use super::avx::Fa;
-#[cfg(target_arch = "x86_64")]
-use super::avx512::Fz;
-use super::lanes::{rotation_arc_from_lanes, Lane, Mask, Trs, F, LANES, M, Q, V3};
-use super::vrm_contact::{collide_tail, Placed};
-use super::Isa;
+use super::contact::{collide_tail, Placed};
 use crate::dynamics::vrm::{PlacedVrmCollider, VrmMode, VrmRig};
+#[cfg(target_arch = "x86_64")]
+use crate::lanes::avx::Fa;
+#[cfg(target_arch = "x86_64")]
+use crate::lanes::avx512::Fz;
+use crate::lanes::Isa;
+use crate::lanes::{rotation_arc_from_lanes, Lane, Mask, Trs, F, LANES, M, Q, V3};
 use crate::math::{normalize_or, Transform};
 use crate::pose::compose_joints;
 use crate::skeleton::Skeleton;
@@ -285,7 +285,7 @@ impl SpringLanes {
         step_models: &mut [Transform],
         isa: Isa,
     ) {
-        super::lanes::lerp_transforms_at(prev, now, w, &self.step_read, step_locals, isa);
+        crate::lanes::lerp_transforms_at(prev, now, w, &self.step_read, step_locals, isa);
         let read = self.step_read.iter().copied();
         compose_joints(sk, read, None, step_locals, step_models);
         for &j in &self.step_links {
@@ -467,7 +467,7 @@ impl SpringLanes {
     #[inline(never)]
     fn update_avx2(&self, rig: &VrmRig, io: &mut SpringIo<'_>) {
         // The explicit AVX2 lane type only inside this function, after the CPU was found
-        // to have AVX2 (the condition of its soundness, `crowd/avx.rs`).
+        // to have AVX2 (the condition of its soundness, `lanes/avx.rs`).
         self.update_lanes::<Fa>(rig, io)
     }
 
@@ -476,7 +476,7 @@ impl SpringLanes {
     #[inline(never)]
     fn update_avx512(&self, rig: &VrmRig, io: &mut SpringIo<'_>) {
         // The explicit AVX-512 lane type only inside this function, after the CPU was
-        // found to have it (the condition of its soundness, `crowd/avx512.rs`).
+        // found to have it (the condition of its soundness, `lanes/avx512.rs`).
         self.update_lanes::<Fz>(rig, io)
     }
 

@@ -1,7 +1,7 @@
 //! One character's bone chains in SIMD lanes: up to [`LANES`] *twin* chains (the same
 //! points, per-point parameters, settings and collider list; hair strands, skirt chains,
-//! a fan of ribbons) side by side, one chain per lane, stepped by the chain crowd's lane
-//! arithmetic ([`super::chain_step`], through [`super::chain`]'s lane-group frame).
+//! a fan of ribbons) side by side, one chain per lane, stepped by the lane step
+//! ([`super::step`], through the lane-group frame [`super::Ctx`]).
 //!
 //! The chain crowd's lanes are characters running the same chain; here they are chains
 //! of one character. The crowd's frame of one chain needs nothing else: each lane has
@@ -9,17 +9,18 @@
 //! character path (here the same), reset flags, step counts and wind generator, and a
 //! chain's frame reads nothing of another chain's. So a group gives each of its chains
 //! the bits the scalar job ([`crate::dynamics::chain::ChainJob`]) gives it: the scalar
-//! job is the readable reference ([`crate::crowd::SimdUse::Scalar`]) the lanes are
+//! job is the readable reference ([`crate::lanes::SimdUse::Scalar`]) the lanes are
 //! tested against.
 
-pub(crate) use super::chain::LaneFrame;
-use super::chain::Twins;
-use super::chain_step::LaneShape;
-use super::lanes::{rotation_arc, Lane, Mask, F, LANES, M, Q, V3};
-use super::Isa;
+pub(crate) use super::frame::LaneFrame;
+use super::frame::{any_planar, Ctx};
+use super::pack::{Pack, Scratch};
+use super::step::LaneShape;
+use crate::collide::lanes::Bound;
 use crate::collide::PlacedCollider;
 use crate::dynamics::chain::compile::{ChainRig, CompiledChain, NONE};
 use crate::dynamics::path::CharacterPath;
+use crate::lanes::{rotation_arc, Isa, Lane, Mask, Trs, F, LANES, M, Q, V3};
 use crate::math::Transform;
 use crate::rng::SplitMix64;
 use crate::skeleton::Skeleton;
@@ -392,7 +393,7 @@ impl ChainLanes {
         turned: &mut Vec<TurnedRow>,
     ) {
         // The explicit AVX2 lane type, only here after the CPU was found to have AVX2.
-        self.write_back_lanes::<super::avx::Fa>(group, rotators, locals, models, turned)
+        self.write_back_lanes::<crate::lanes::avx::Fa>(group, rotators, locals, models, turned)
     }
 
     #[cfg(target_arch = "x86_64")]
@@ -406,7 +407,7 @@ impl ChainLanes {
         turned: &mut Vec<TurnedRow>,
     ) {
         // The explicit AVX-512 lane type, only here after the CPU was found to have it.
-        self.write_back_lanes::<super::avx512::Fz>(group, rotators, locals, models, turned)
+        self.write_back_lanes::<crate::lanes::avx512::Fz>(group, rotators, locals, models, turned)
     }
 
     /// [`ChainLanes::write_back`] computed in the lane type `T`.
@@ -503,5 +504,146 @@ impl ChainLanes {
             colliders,
             out,
         );
+    }
+}
+/// The lanes of [`ChainLanes`]: a lane group whose "characters" are twin chains of
+/// one character, run by the crowd's frame of one chain (`rig` is that chain as a rig of
+/// its own).
+#[derive(Debug, Clone)]
+pub(crate) struct Twins {
+    pub(crate) pack: Pack,
+    pub(crate) scratch: Scratch,
+}
+
+impl Twins {
+    /// Lanes for `count` twins of `rig`'s one chain.
+    pub(crate) fn new(rig: &ChainRig, count: usize) -> Twins {
+        let mut pack = Pack::new(rig);
+        pack.count = count;
+        pack.shared = true;
+        Twins {
+            pack,
+            scratch: Scratch::new(rig, 0),
+        }
+    }
+
+    /// Whether these lanes were made for `count` twins of `rig`'s one chain.
+    pub(crate) fn fits(&self, rig: &ChainRig, count: usize) -> bool {
+        self.pack.count == count
+            && self.pack.pos.len() == rig.point_count()
+            && self.scratch.colliders.len() == rig.colliders.len() * LANES
+    }
+
+    /// Lane `l` from chain `ci` (points from `start`) of the scalar state `s`.
+    pub(crate) fn load_lane(&mut self, l: usize, ci: usize, start: usize, s: &mut ScalarChains) {
+        let p = &mut self.pack;
+        for k in 0..p.pos.len() {
+            let q = start + k;
+            p.pos[k].set(l, s.pos[q]);
+            p.prev[k].set(l, s.prev[q]);
+            p.dev[k].set(l, s.dev[q]);
+            p.dev_before[k].set(l, s.dev_before[q]);
+            p.prev_targets[k].set(l, s.prev_targets[q]);
+            p.prev_normals[k].set(l, s.prev_normals[q]);
+        }
+        let (m, at) = (s.prev_colliders.len(), l * p.collider_stride());
+        p.prev_colliders[at..at + m].copy_from_slice(s.prev_colliders);
+        p.last_step_component[0].set(l, &s.last_step_component[ci]);
+        p.accumulator[0].0[l] = s.accumulator[ci];
+        p.dt_old[0].0[l] = s.dt_old[ci];
+        p.rng[0][l] = s.rng[ci];
+        p.needs_reset[0][l] = s.needs_reset[ci];
+        p.paths[l] = *s.path;
+        p.prev_component.set(l, &s.prev_component);
+        p.teleports[l] = 0;
+    }
+
+    /// Lane `l` back into chain `ci` (points from `start`) of the scalar state `s`.
+    pub(crate) fn store_lane(&mut self, l: usize, ci: usize, start: usize, s: &mut ScalarChains) {
+        let p = &mut self.pack;
+        for k in 0..p.pos.len() {
+            let q = start + k;
+            s.pos[q] = p.pos[k].get(l);
+            s.prev[q] = p.prev[k].get(l);
+            s.dev[q] = p.dev[k].get(l);
+            s.dev_before[q] = p.dev_before[k].get(l);
+            s.prev_targets[q] = p.prev_targets[k].get(l);
+            s.prev_normals[q] = p.prev_normals[k].get(l);
+        }
+        s.last_step_component[ci] = p.last_step_component[0].get(l);
+        s.accumulator[ci] = p.accumulator[0].0[l];
+        s.dt_old[ci] = p.dt_old[0].0[l];
+        s.rng[ci] = p.rng[0][l];
+        s.needs_reset[ci] = p.needs_reset[0][l];
+        *s.teleports += p.teleports[l];
+        p.teleports[l] = 0;
+    }
+
+    /// The last frame's animated targets and output points, per point of the chain,
+    /// lane by lane.
+    pub(crate) fn targets_and_out(&self) -> (&[V3], &[V3]) {
+        (&self.scratch.targets, &self.pack.out)
+    }
+
+    /// Every lane starts again from its pose on the next frame.
+    pub(crate) fn reset(&mut self) {
+        self.pack.needs_reset[0] = [true; LANES];
+    }
+
+    /// Resets in the lanes in use since they were loaded.
+    pub(crate) fn teleports(&self) -> u64 {
+        self.pack.teleports[..self.pack.count].iter().sum()
+    }
+
+    /// One frame: lane `l` reads the points of the chain starting at the `l`th of
+    /// `starts` in `targets` and `normals`, every lane the same placed `colliders`; the
+    /// lanes' output points are written back there into `out`.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn frame(
+        &mut self,
+        sk: &Skeleton,
+        rig: &ChainRig,
+        shapes: &[LaneShape],
+        frame: &LaneFrame,
+        starts: impl Iterator<Item = usize> + Clone,
+        targets: &[Vec3],
+        normals: &[Vec3],
+        colliders: &[PlacedCollider],
+        out: &mut [Vec3],
+    ) {
+        let (pack, s) = (&mut self.pack, &mut self.scratch);
+        let n = pack.pos.len();
+        let m = colliders.len();
+        // The normals only where a planar constraint reads them (`rig` is one chain).
+        let planar = rig.planar_axis(0).is_some();
+        for (l, start) in starts.clone().enumerate() {
+            for k in 0..n {
+                s.targets[k].set(l, targets[start + k]);
+                if planar {
+                    s.normals[k].set(l, normals[start + k]);
+                }
+            }
+        }
+        // The same colliders in every lane: kept once (`Pack::collider_stride`), and each
+        // bound computed once.
+        s.colliders[..m].copy_from_slice(colliders);
+        for (b, c) in s.bounds.iter_mut().zip(colliders) {
+            *b = Bound::splat(c);
+        }
+        s.component = Trs::splat(&frame.component);
+        Ctx {
+            sk,
+            rig,
+            shapes,
+            planar: any_planar(rig),
+            dt: frame.dt,
+            isa: frame.isa,
+        }
+        .step(pack, s, false, None);
+        for (l, start) in starts.enumerate() {
+            for k in 0..n {
+                out[start + k] = pack.out[k].get(l);
+            }
+        }
     }
 }

@@ -15,9 +15,8 @@
 //! few `f32` operations) is inlined where it is asked: out of line, the call and its
 //! arguments' trip through memory cost one character about 2 %.
 
-use super::chain_step::{entry_radius_lanes, LaneContact};
-use super::lanes::{closest_point_on_segment, Lane, F, LANES};
-use super::lanes::{Mask, M, V3};
+use super::lanes::{entry_radius_lanes, LaneContact};
+use crate::lanes::{closest_point_on_segment, Isa, Lane, Mask, F, LANES, M, V3};
 
 /// One `f64` per lane.
 #[derive(Clone, Copy)]
@@ -243,9 +242,9 @@ fn slide<T: Lane>(contact: V3<T>, p: V3<T>, n: V3<T>) -> V3<T> {
 
 /// [`crate::collide::push_out_of_sphere`] per lane for a step that entered the sphere
 /// (`center`, `limit`): stopped where it met the entry surface, slid on, then kept
-/// outside. For the lanes [`super::chain_step::sphere_contact`] found `entered`.
+/// outside. For the lanes [`super::lanes::sphere_contact`] found `entered`.
 #[inline(always)]
-pub(super) fn sphere_entry<T: Lane>(
+pub(crate) fn sphere_entry<T: Lane>(
     p: V3<T>,
     prev: V3<T>,
     center: V3<T>,
@@ -286,12 +285,12 @@ fn outside_capsule<T: Lane>(p: V3<T>, a: V3<T>, b: V3<T>, limit: T, fallback: V3
 /// [`crate::collide::push_out_of_capsule`] per lane for a step that entered the capsule
 /// `a`–`b` (`limit`): stopped where it met the entry surface (found in closed form, in
 /// `f64`), slid on, then kept outside. For the lanes
-/// [`super::chain_step::capsule_contact`] found `entered`; also returns the lanes whose
+/// [`super::lanes::capsule_contact`] found `entered`; also returns the lanes whose
 /// closed form found no root (`hard`: the scalar function bisects there), whose point is
 /// not answered. The step's start's distance from the axis, the share of the step at
 /// its closest approach and the fallback direction are `contact`'s (the same operations).
 #[inline(always)]
-pub(super) fn capsule_entry_push<T: Lane>(
+pub(crate) fn capsule_entry_push<T: Lane>(
     p: V3<T>,
     prev: V3<T>,
     a: V3<T>,
@@ -315,7 +314,7 @@ pub(super) fn capsule_entry_push<T: Lane>(
 /// left to the scalar narrow phase. Out of line: in AVX2 for the AVX lane type, else in
 /// the portable one (the same bits).
 #[inline(always)]
-pub(super) fn capsule_entry_out_of_line<T: Lane>(
+pub(crate) fn capsule_entry_out_of_line<T: Lane>(
     p: V3<T>,
     prev: V3<T>,
     a: V3<T>,
@@ -335,19 +334,19 @@ pub(super) fn capsule_entry_out_of_line<T: Lane>(
     );
     // SAFETY (both): a value of an explicit lane type exists only inside functions
     // compiled with its instructions after the CPU was found to have them
-    // (`crowd/avx.rs`, `crowd/avx512.rs`), so the CPU has them.
+    // (`lanes/avx.rs`, `lanes/avx512.rs`), so the CPU has them.
     #[cfg(target_arch = "x86_64")]
     #[allow(unsafe_code)]
     match T::ISA {
-        super::Isa::Avx512 => {
+        Isa::Avx512 => {
             let (e, h) = unsafe { entry_avx512(args) };
             return (V3::of(e), <T::M as Mask>::of(h));
         }
-        super::Isa::Avx2 => {
+        Isa::Avx2 => {
             let (e, h) = unsafe { entry_avx2(args) };
             return (V3::of(e), <T::M as Mask>::of(h));
         }
-        super::Isa::Portable => {}
+        Isa::Portable => {}
     }
     let (e, h) = entry_portable(args);
     (V3::of(e), <T::M as Mask>::of(h))
@@ -365,14 +364,14 @@ fn entry_portable(args: EntryArgs) -> (V3, M) {
 #[target_feature(enable = "avx2")]
 #[inline(never)]
 fn entry_avx2(args: EntryArgs) -> (V3, M) {
-    entry_in::<super::avx::Fa>(args)
+    entry_in::<crate::lanes::avx::Fa>(args)
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512dq,avx512vl,avx512bw")]
 #[inline(never)]
 fn entry_avx512(args: EntryArgs) -> (V3, M) {
-    entry_in::<super::avx512::Fz>(args)
+    entry_in::<crate::lanes::avx512::Fz>(args)
 }
 
 #[inline(always)]

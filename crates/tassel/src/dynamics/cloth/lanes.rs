@@ -6,7 +6,7 @@
 //! - **Points**: a point's answer depends on that point alone, so [`LANES`] points go side
 //!   by side through every collider in order: the collider's quick rejection and, for
 //!   keep-out spheres and capsules, the narrow phase's contact decision and push out
-//!   (the chain lanes' own, `chain_step.rs`); a step that *entered* a shape, and every
+//!   (`collide/lanes.rs`, the chain lanes' too); a step that *entered* a shape, and every
 //!   other shape, goes to the scalar collider for the lanes that need it.
 //! - **Segments and triangles** are tested in order, and a push moves points that later
 //!   segments and triangles share, so the lanes *look ahead*: before the pass they test
@@ -18,25 +18,26 @@
 //!   would be pushed, or whose points moved, is done by the scalar code from there on.
 //!   Where nothing touches (most of the time), nothing is left to the scalar code.
 
-use super::chain_step::{capsule_contact, sphere_contact, vmax, vmin};
-use super::lanes::{
-    angle_between, closest_point_on_segment, differs, rotation_arc, turned_toward, Lane, Mask, F,
-    LANES, M, V3,
-};
+use crate::collide::lanes::{capsule_contact, sphere_contact};
 use crate::collide::{PlacedCollider, Shape};
 use crate::dynamics::cloth::compile::ClothRig;
 use crate::dynamics::cloth::contact::{
     push_segment, push_triangle_against, push_triangle_against_from, Core, TriangleFrame,
 };
 use crate::dynamics::cloth::SurfaceCollision;
+use crate::lanes::{
+    angle_between, closest_point_on_segment, differs, rotation_arc, turned_toward, Lane, Mask, F,
+    LANES, M, V3,
+};
+use crate::lanes::{vmax, vmin};
 use crate::math::same_bits;
 use glam::Vec3;
 
 #[cfg(target_arch = "x86_64")]
-use super::avx::Fa;
+use crate::lanes::avx::Fa;
 #[cfg(target_arch = "x86_64")]
-use super::avx512::Fz;
-use super::Isa;
+use crate::lanes::avx512::Fz;
+use crate::lanes::Isa;
 
 /// What one contact pass keeps between its look-ahead and its walk. Lives in the cloth
 /// state; sized on first use, so a frame allocates nothing.
@@ -137,7 +138,7 @@ fn limit_angles_in<T: Lane>(rig: &ClothRig, ci: usize, targets: &[Vec3], pos: &m
     for group in cloth.chains.chunks(LANES) {
         // Point `k` of each chain of the group (lanes past a chain's end left at zero).
         // (In `F`: the conversion to `T` is left to the caller, a closure being compiled
-        // without its caller's target features: see `chain_step::select_max`.)
+        // without its caller's target features: see `collide::lanes::select_max`.)
         let gather = |k: usize, from: &[Vec3]| {
             let mut v = V3::ZERO;
             for (l, ch) in group.iter().enumerate() {
@@ -748,7 +749,7 @@ fn closest_point_on_triangle<T: Lane>(p: V3<T>, a: V3<T>, b: V3<T>, c: V3<T>) ->
     let bp = p - b;
     let d3 = ab.dot(bp);
     let d4 = ac.dot(bp);
-    // (A function, not a closure: see `chain_step::select_max`.)
+    // (A function, not a closure: see `collide::lanes::select_max`.)
     let take = take_where_open::<T>;
     take(&mut done, zero.le(d3).and(d4.le(d3)), b, &mut out);
     let vc = d1 * d4 - d3 * d2;

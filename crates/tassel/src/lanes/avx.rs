@@ -1,4 +1,4 @@
-//! The crowd's AVX2 lane type: [`Fa`], two `__m256` per [`F`] (its sixteen lanes in two
+//! The AVX2 lane type: [`Fa`], two `__m256` per [`F`] (its sixteen lanes in two
 //! halves), every operation two 256-bit instructions.
 //!
 //! Why it exists: the lane types over [`F`] (arrays of `f32`) leave vectorisation to
@@ -6,8 +6,8 @@
 //! good part of it into 128-bit halves and per-lane shuffles (measured: in `step_avx2` a
 //! third of the arithmetic was 128-bit, with ~1 000 shuffles and inserts). Written with
 //! the intrinsics, every lane operation is one instruction per half whatever the
-//! context. A CPU with AVX-512 runs `crowd/avx512.rs`'s type instead (one instruction
-//! for all sixteen lanes); this one is how the others run ([`crate::crowd::SimdUse::Avx2`]
+//! context. A CPU with AVX-512 runs `lanes/avx512.rs`'s type instead (one instruction
+//! for all sixteen lanes); this one is how the others run ([`crate::lanes::SimdUse::Avx2`]
 //! forces it).
 //!
 //! Each operation is the IEEE operation per lane that [`F`]'s is (add, subtract,
@@ -15,19 +15,19 @@
 //! comparisons: ordered, `!=` unordered as Rust's; select: bitwise), so both types give
 //! the same bits; `tests` checks it operation by operation.
 //!
-//! **Soundness.** The intrinsics need AVX2. [`Fa`] and [`Ma`] are private to the crowd and
-//! only ever created inside functions compiled with `#[target_feature(enable = "avx2")]`
-//! that are called where [`crate::crowd::Isa::of`] said [`crate::crowd::Isa::Avx2`],
-//! which it says only after `is_x86_feature_detected!("avx2")` said yes (the `*_avx2`
-//! functions of `vrm.rs`, `chain.rs`, `chain_lanes.rs`, `spring_lanes.rs`, `lanes.rs`
-//! and `cloth_lanes.rs`; `entry_avx2` in `entry_lanes.rs`, called only where an [`Fa`]
-//! exists already; the tests below check the same first), so no AVX instruction runs
-//! on a CPU without it. The operations are `#[inline(always)]` so that they are
+//! **Soundness.** The intrinsics need AVX2. [`Fa`] and [`Ma`] are private to the crate
+//! and only ever created inside functions compiled with `#[target_feature(enable =
+//! "avx2")]` that are called where [`crate::lanes::Isa::of`] said
+//! [`crate::lanes::Isa::Avx2`], which it says only after `is_x86_feature_detected!("avx2")`
+//! said yes (the `*_avx2` functions of `lanes/types.rs`, `dynamics/chain/lanes/`,
+//! `dynamics/vrm/lanes/` and `dynamics/cloth/lanes.rs`; `entry_avx2` in
+//! `collide/entry_lanes.rs`, called only where an [`Fa`] exists already; the tests below
+//! check the same first), so no AVX instruction runs on a CPU without it. The operations are `#[inline(always)]` so that they are
 //! compiled inside those functions.
 #![allow(unsafe_code)]
 
-use super::lanes::{Lane, Mask, F, M};
 use super::Isa;
+use super::{Lane, Mask, F, M};
 use std::arch::x86_64::*;
 use std::ops::{Add, Div, Mul, Neg, Sub};
 
@@ -268,7 +268,7 @@ impl Mask for Ma {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::crowd::lane_check;
+    use crate::lanes::check as lane_check;
 
     /// Runs `f` only where the CPU has AVX2 (the type's precondition), saying so else.
     fn with_avx2(f: impl FnOnce()) {
