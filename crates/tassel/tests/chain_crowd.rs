@@ -202,7 +202,8 @@ fn chain_crowd_is_the_same_on_one_and_two_threads_and_without_avx2() {
     );
 }
 
-/// Bad input names the character; its lane group keeps its state, the others step, and
+/// Bad input names the character, which is held (its state as before); every other
+/// character, in its lane group too, steps exactly as in a crowd given only good input;
 /// the next good frame goes on.
 #[test]
 fn chain_crowd_rejects_bad_input_by_character() {
@@ -226,8 +227,15 @@ fn chain_crowd_rejects_bad_input_by_character() {
             })
             .unwrap();
     }
-    let tip = rig.point_count() - 1;
-    let before: Vec<Vec3> = (0..20).map(|i| crowd.point(i, tip).unwrap()).collect();
+    // The same crowd given good input: the reference for everyone but 17.
+    let mut good = crowd.clone();
+    let points = rig.point_count();
+    let bits = |c: &ChainCrowd, i: usize| -> Vec<[u32; 3]> {
+        (0..points)
+            .map(|k| c.point(i, k).unwrap().to_array().map(f32::to_bits))
+            .collect()
+    };
+    let before: Vec<_> = (0..20).map(|i| bits(&crowd, i)).collect();
     let err = crowd
         .frame(1.0 / 60.0, |i| CrowdPose {
             transform: at(2, i),
@@ -239,10 +247,22 @@ fn chain_crowd_rejects_bad_input_by_character() {
         err.contains("crowd character 17") && err.contains(sk.name(3)),
         "{err}"
     );
-    for (i, b) in before.iter().enumerate() {
-        let kept = crowd.point(i, tip).unwrap() == *b;
-        assert_eq!(kept, i >= 16, "character {i}: only 17's lane group is held");
+    let held: Vec<usize> = crowd.held().map(|(i, _)| i).collect();
+    assert_eq!(held, [17]);
+    good.frame(1.0 / 60.0, |i| CrowdPose {
+        transform: at(2, i),
+        locals: &rest,
+    })
+    .unwrap();
+    for i in 0..20 {
+        if i == 17 {
+            assert_eq!(bits(&crowd, i), before[i], "17 is held");
+        } else {
+            assert_ne!(bits(&crowd, i), before[i], "character {i} stepped");
+            assert_eq!(bits(&crowd, i), bits(&good, i), "character {i}");
+        }
     }
+    let tip = points - 1;
     let short = &rest[..3];
     let err = crowd
         .frame(1.0 / 60.0, |i| CrowdPose {

@@ -267,7 +267,8 @@ fn vrm_crowd_is_the_same_on_one_and_two_threads() {
     );
 }
 
-/// Bad input names the character; its lane group keeps its state, the others step, and
+/// Bad input names the character, which is held (its state as before); every other
+/// character, in its lane group too, steps exactly as in a crowd given only good input;
 /// the next good frame goes on.
 #[test]
 fn vrm_crowd_rejects_bad_input_by_character() {
@@ -283,13 +284,22 @@ fn vrm_crowd_rejects_bad_input_by_character() {
     bad[3].translation.x = f32::NAN;
     let at =
         |f: usize, i: usize| Transform::from_translation(Vec3::X * (f as f32 * 0.05 + i as f32));
-    crowd
-        .frame(1.0 / 60.0, |i| CrowdPose {
+    // The same crowd given good input throughout: the reference for everyone but 17.
+    let mut good = crowd.clone();
+    for c in [&mut crowd, &mut good] {
+        c.frame(1.0 / 60.0, |i| CrowdPose {
             transform: at(0, i),
             locals: &rest,
         })
         .unwrap();
-    let before: Vec<Quat> = (0..20).map(|i| crowd.rotation(i, 2).unwrap()).collect();
+    }
+    let links = rig.links.len();
+    let bits = |c: &VrmCrowd, i: usize| -> Vec<[u32; 4]> {
+        (0..links)
+            .map(|k| c.rotation(i, k).unwrap().to_array().map(f32::to_bits))
+            .collect()
+    };
+    let before: Vec<_> = (0..20).map(|i| bits(&crowd, i)).collect();
     let err = crowd
         .frame(1.0 / 60.0, |i| CrowdPose {
             transform: at(1, i),
@@ -301,9 +311,20 @@ fn vrm_crowd_rejects_bad_input_by_character() {
         err.contains("crowd character 17") && err.contains(sk.name(3)),
         "{err}"
     );
+    let held: Vec<usize> = crowd.held().map(|(i, _)| i).collect();
+    assert_eq!(held, [17]);
+    good.frame(1.0 / 60.0, |i| CrowdPose {
+        transform: at(1, i),
+        locals: &rest,
+    })
+    .unwrap();
     for i in 0..20 {
-        let kept = crowd.rotation(i, 2).unwrap() == before[i];
-        assert_eq!(kept, i >= 16, "character {i}: only 17's lane group is held");
+        if i == 17 {
+            assert_eq!(bits(&crowd, i), before[i], "17 is held");
+        } else {
+            assert_ne!(bits(&crowd, i), before[i], "character {i} stepped");
+            assert_eq!(bits(&crowd, i), bits(&good, i), "character {i}");
+        }
     }
     let short = &rest[..3];
     let err = crowd

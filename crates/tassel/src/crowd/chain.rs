@@ -6,6 +6,7 @@
 use super::CrowdPose;
 use crate::dynamics::chain::compile::ChainRig;
 use crate::dynamics::chain::lanes::{any_planar, Ctx, LaneShape, Pack, Scratch};
+use crate::dynamics::path::CharacterPath;
 use crate::error::{Error, Result};
 use crate::lanes::{Isa, SimdUse, LANES};
 use crate::math::Transform;
@@ -144,6 +145,14 @@ impl ChainCrowd {
         self.simd = simd;
     }
 
+    /// The characters the last frame held for bad input (index, and what was wrong), in
+    /// index order; empty after a good frame.
+    pub fn held(&self) -> impl Iterator<Item = (usize, &Error)> + '_ {
+        self.packs
+            .iter()
+            .flat_map(|p| p.held.iter().map(|(i, e)| (*i, e)))
+    }
+
     /// Number of characters.
     pub fn len(&self) -> usize {
         self.len
@@ -175,12 +184,16 @@ impl ChainCrowd {
         }
     }
 
-    /// Makes character `i` start again from its pose on the next frame.
+    /// Makes character `i` start again from its pose on the next frame, wherever it was
+    /// before (as a [`crate::CharacterSim`] reset: that frame's time step changes nothing).
     pub fn reset(&mut self, i: usize) -> Result<()> {
         self.check(i)?;
-        for n in &mut self.packs[i / LANES].needs_reset {
+        let pack = &mut self.packs[i / LANES];
+        for n in &mut pack.needs_reset {
             n[i % LANES] = true;
         }
+        // As `ChainState::reset`: the path before is forgotten.
+        pack.paths[i % LANES] = CharacterPath::default();
         Ok(())
     }
 
@@ -213,6 +226,22 @@ impl ChainCrowd {
         locals: &mut [Transform],
         models: &mut [Transform],
     ) -> Result<()> {
+        self.write_rotations(i, locals)?;
+        LocalToModelJob {
+            skeleton: &self.skeleton,
+            root: Transform::IDENTITY,
+            locals,
+            models,
+        }
+        .run()
+    }
+
+    /// Character `i`'s simulated local rotations after the last frame, written into
+    /// `locals` (its animated pose of that frame on entry) and nothing else: the local
+    /// pose [`Self::write_pose`] gives, without composing the model pose. The chains only
+    /// turn joints, so these are every local transform the crowd changes (the joints of
+    /// [`ChainRig::rotator_joints`]). Never allocates.
+    pub fn write_rotations(&self, i: usize, locals: &mut [Transform]) -> Result<()> {
         self.check(i)?;
         let n = self.skeleton.len();
         if locals.len() != n {
@@ -226,23 +255,19 @@ impl ChainCrowd {
         for (k, (joint, _, _)) in self.rig.rotators.iter().enumerate() {
             locals[*joint as usize].rotation = pack.out_rotation[k].get(i % LANES);
         }
-        LocalToModelJob {
-            skeleton: &self.skeleton,
-            root: Transform::IDENTITY,
-            locals,
-            models,
-        }
-        .run()
+        Ok(())
     }
 
     /// Advances every character by `dt` seconds (finite, ≥ 0). `input(i)` gives character
     /// `i`'s world transform and animated pose; it is called once per character, from
     /// the rayon pool's threads.
     ///
-    /// A character whose input is bad (wrong length, not finite, beyond the limits) makes
-    /// the frame return an error naming it; the [`LANES`] characters of its lane group
-    /// are not stepped this frame, every other character is. Never allocates once each
-    /// thread has run a frame.
+    /// A character whose input is bad (wrong length, not finite, beyond the limits) is
+    /// held: not stepped this frame (its state and results stay as they were, as a
+    /// [`crate::CharacterSim`] whose frame fails), while every other character steps as
+    /// it would have. The frame then returns the error of the first held character (by
+    /// index) and [`Self::held`] lists them all. Never allocates once each thread has
+    /// run a frame, except for the characters it holds.
     pub fn frame<'a, I>(&mut self, dt: f32, input: I) -> Result<()>
     where
         I: Fn(usize) -> CrowdPose<'a> + Sync,
@@ -269,6 +294,7 @@ impl ChainCrowd {
             isa: Isa::of(self.simd),
         };
         let input = &input;
+        let rest_pose = self.skeleton.rest();
         self.packs
             .par_chunks_mut(chunk)
             .zip(self.scratch[..chunks].par_iter_mut())
@@ -283,14 +309,15 @@ impl ChainCrowd {
                         next.prefetch_frame_state();
                     }
                     let base = (c * chunk + k) * LANES;
-                    pack.error = ctx.gather(pack, scratch, base, input).err();
-                    if pack.error.is_none() {
-                        ctx.step(pack, scratch, true, next);
-                    }
+                    let kept = super::run_holding(pack, base, rest_pose, input, |pack, f| {
+                        ctx.gather(pack, scratch, base, &f)
+                    });
+                    ctx.step(pack, scratch, true, next);
+                    super::restore(pack, kept);
                 }
             });
-        match self.packs.iter().find_map(|p| p.error.clone()) {
-            Some((_, e)) => Err(e),
+        match self.packs.iter().find_map(|p| p.held.first()) {
+            Some((_, e)) => Err(e.clone()),
             None => Ok(()),
         }
     }

@@ -18,6 +18,124 @@ pub use crate::pose::CrowdPose;
 pub use chain::ChainCrowd;
 pub use vrm::VrmCrowd;
 
+use crate::error::Error;
+use crate::math::Transform;
+use crate::CharacterRig;
+
+/// The crowd that can step characters of a kind ([`CrowdKind::of`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CrowdKind {
+    /// [`VrmCrowd`]: the kind's only solver is VRM spring bones.
+    Vrm,
+    /// [`ChainCrowd`]: the kind's only solver is bone chains.
+    Chains,
+}
+
+impl CrowdKind {
+    /// Which crowd steps characters of `rig` as [`crate::CharacterSim::from_rig`] would,
+    /// bit for bit (a crowd has no level: a `CharacterSim` given one with
+    /// [`crate::CharacterSim::set_level`] differs where chains collide with it); `None`
+    /// when the kind has springs, cloths or ropes, or several kinds of solver.
+    pub fn of(rig: &CharacterRig) -> Option<CrowdKind> {
+        let others = !rig.springs.is_empty() || !rig.cloths.is_empty() || !rig.ropes.is_empty();
+        let (vrm, chains) = (!rig.vrm.links.is_empty(), rig.chains.chain_count() > 0);
+        match (others, vrm, chains) {
+            (false, true, false) => Some(CrowdKind::Vrm),
+            (false, false, true) => Some(CrowdKind::Chains),
+            _ => None,
+        }
+    }
+}
+
+/// A lane group as a crowd's frame holds its bad characters: its list of held
+/// characters, and one lane's whole state out and back in.
+trait Group {
+    /// One lane's state.
+    type Lane;
+    fn held(&mut self) -> &mut Vec<(usize, Error)>;
+    fn take(&mut self, l: usize) -> Self::Lane;
+    fn put(&mut self, l: usize, s: &Self::Lane);
+}
+
+impl Group for crate::dynamics::chain::lanes::Pack {
+    type Lane = crate::dynamics::chain::lanes::LaneState;
+    fn held(&mut self) -> &mut Vec<(usize, Error)> {
+        &mut self.held
+    }
+    fn take(&mut self, l: usize) -> Self::Lane {
+        self.lane(l)
+    }
+    fn put(&mut self, l: usize, s: &Self::Lane) {
+        self.set_lane(l, s)
+    }
+}
+
+impl Group for crate::dynamics::vrm::lanes::Pack {
+    type Lane = crate::dynamics::vrm::lanes::LaneState;
+    fn held(&mut self) -> &mut Vec<(usize, Error)> {
+        &mut self.held
+    }
+    fn take(&mut self, l: usize) -> Self::Lane {
+        self.lane(l)
+    }
+    fn put(&mut self, l: usize, s: &Self::Lane) {
+        self.set_lane(l, s)
+    }
+}
+
+/// One character's input as a lane group's frame reads it.
+type Input<'p, 'a> = &'p (dyn Fn(usize) -> CrowdPose<'a> + Sync);
+
+/// Runs `attempt` (a lane group's input checks, alone or with its step: `Err((lane, _))`
+/// where a lane's input is bad, having touched no state) until it passes, each time with
+/// the bad lane's character held: its error recorded, its state kept aside, and a stand-in
+/// input for it (the rest pose `rest` at the origin, which every check passes). Lanes are
+/// independent, so the others' results are those of a frame without the held characters.
+/// Returns the held lanes' states, for [`restore`] after the step.
+fn run_holding<'a, 'r, P: Group, I>(
+    pack: &mut P,
+    base: usize,
+    rest: &'r [Transform],
+    input: &I,
+    mut attempt: impl FnMut(&mut P, Input<'_, 'r>) -> std::result::Result<(), (usize, Error)>,
+) -> Vec<(usize, P::Lane)>
+where
+    I: Fn(usize) -> CrowdPose<'a> + Sync,
+    'a: 'r,
+{
+    pack.held().clear();
+    let mut kept = Vec::new();
+    let mut held = [false; lanes::LANES];
+    loop {
+        let h = held;
+        let f = |i: usize| -> CrowdPose<'r> {
+            if h[i - base] {
+                CrowdPose {
+                    transform: Transform::IDENTITY,
+                    locals: rest,
+                }
+            } else {
+                input(i)
+            }
+        };
+        match attempt(pack, &f) {
+            Ok(()) => return kept,
+            Err((lane, e)) => {
+                held[lane] = true;
+                pack.held().push((base + lane, e));
+                kept.push((lane, pack.take(lane)));
+            }
+        }
+    }
+}
+
+/// The held lanes' states back, as [`run_holding`] kept them.
+fn restore<P: Group>(pack: &mut P, kept: Vec<(usize, P::Lane)>) {
+    for (l, s) in &kept {
+        pack.put(*l, s);
+    }
+}
+
 /// Swaps the characters in lanes `i` and `j` of a crowd's lane groups ([`lanes::LANES`]
 /// characters each, in index order): `take` copies one lane's state out, `put` writes
 /// it into a lane.

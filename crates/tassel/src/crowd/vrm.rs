@@ -61,6 +61,8 @@ pub struct VrmCrowd {
     skeleton: Arc<Skeleton>,
     rig: Arc<VrmRig>,
     plan: Plan,
+    /// Every joint, ascending ([`Self::input_joints`] with node constraints).
+    all_joints: Vec<usize>,
     packs: Vec<Pack>,
     len: usize,
     scratch: Vec<Scratch>,
@@ -82,10 +84,12 @@ impl VrmCrowd {
         }
         let plan = Plan::new(&skeleton, &rig)?;
         let links = rig.links.len();
+        let all_joints = (0..skeleton.len()).collect();
         Ok(Self {
             skeleton,
             rig,
             plan,
+            all_joints,
             packs: Vec::new(),
             len: 0,
             scratch: Vec::new(),
@@ -156,6 +160,14 @@ impl VrmCrowd {
         self.simd = simd;
     }
 
+    /// The characters the last frame held for bad input (index, and what was wrong), in
+    /// index order; empty after a good frame.
+    pub fn held(&self) -> impl Iterator<Item = (usize, &Error)> + '_ {
+        self.packs
+            .iter()
+            .flat_map(|p| p.held.iter().map(|(i, e)| (*i, e)))
+    }
+
     /// Number of characters.
     pub fn len(&self) -> usize {
         self.len
@@ -187,10 +199,14 @@ impl VrmCrowd {
         }
     }
 
-    /// Makes character `i` start again from its pose on the next frame.
+    /// Makes character `i` start again from its pose on the next frame, wherever it was
+    /// before (as a [`crate::CharacterSim`] reset: that frame's time step changes nothing).
     pub fn reset(&mut self, i: usize) -> Result<()> {
         self.check(i)?;
-        self.packs[i / LANES].needs_reset[i % LANES] = true;
+        let pack = &mut self.packs[i / LANES];
+        pack.needs_reset[i % LANES] = true;
+        // As `VrmState::reset`: the path before is forgotten.
+        pack.paths[i % LANES] = CharacterPath::default();
         Ok(())
     }
 
@@ -256,15 +272,52 @@ impl VrmCrowd {
         .run()
     }
 
+    /// Character `i`'s spring rotations after the last frame, written into `locals` (its
+    /// animated pose of that frame on entry) and nothing else, without composing a model
+    /// pose. Without node constraints these are every local transform the crowd changes,
+    /// and `locals` ends as [`Self::write_pose`] leaves it; with node constraints (the rig's
+    /// `constraints`) the constrained joints turn too, which only `write_pose` gives.
+    /// Never allocates.
+    pub fn write_rotations(&self, i: usize, locals: &mut [Transform]) -> Result<()> {
+        self.check(i)?;
+        let n = self.skeleton.len();
+        if locals.len() != n {
+            return Err(Error::LengthMismatch {
+                what: "locals",
+                expected: n,
+                got: locals.len(),
+            });
+        }
+        let pack = &self.packs[i / LANES];
+        for (k, l) in self.rig.links.iter().enumerate() {
+            locals[l.joint].rotation = pack.out_rotation[k].get(i % LANES);
+        }
+        Ok(())
+    }
+
+    /// The joints whose animated local transforms a frame uses (every link, tail, centre
+    /// and collider joint and their ancestors; every joint when the rig has node
+    /// constraints), ascending. The other joints' input is only checked against the
+    /// limits: a caller may leave them at rest.
+    pub fn input_joints(&self) -> &[usize] {
+        if self.rig.constraints.list.is_empty() {
+            &self.plan.joints
+        } else {
+            &self.all_joints
+        }
+    }
+
     /// Advances every character by `dt` seconds (finite, ≥ 0; the first frame of a
     /// character only takes its pose, whatever `dt`). `input(i)` gives character `i`'s
     /// world transform and animated pose; it is called once per character, from the
     /// rayon pool's threads.
     ///
-    /// A character whose input is bad (wrong length, not finite, beyond the limits) makes
-    /// the frame return an error naming it; the [`LANES`] characters of its lane group
-    /// are not stepped this frame, every other character is. Never allocates once each
-    /// thread has run a frame.
+    /// A character whose input is bad (wrong length, not finite, beyond the limits) is
+    /// held: not stepped this frame (its state and results stay as they were, as a
+    /// [`crate::CharacterSim`] whose frame fails), while every other character steps as
+    /// it would have. The frame then returns the error of the first held character (by
+    /// index) and [`Self::held`] lists them all. Never allocates once each thread has
+    /// run a frame, except for the characters it holds.
     pub fn frame<'a, I>(&mut self, dt: f32, input: I) -> Result<()>
     where
         I: Fn(usize) -> CrowdPose<'a> + Sync,
@@ -301,6 +354,7 @@ impl VrmCrowd {
             isa: Isa::of(self.simd),
         };
         let input = &input;
+        let rest_pose = self.skeleton.rest();
         self.packs
             .par_chunks_mut(chunk)
             .zip(self.scratch[..chunks].par_iter_mut())
@@ -308,11 +362,14 @@ impl VrmCrowd {
             .for_each(|(c, (packs, scratch))| {
                 for (k, pack) in packs.iter_mut().enumerate() {
                     let base = (c * chunk + k) * LANES;
-                    pack.error = ctx.run(pack, scratch, base, input).err();
+                    let kept = super::run_holding(pack, base, rest_pose, input, |pack, f| {
+                        ctx.run(pack, scratch, base, &f)
+                    });
+                    super::restore(pack, kept);
                 }
             });
-        match self.packs.iter().find_map(|p| p.error.clone()) {
-            Some((_, e)) => Err(e),
+        match self.packs.iter().find_map(|p| p.held.first()) {
+            Some((_, e)) => Err(e.clone()),
             None => Ok(()),
         }
     }

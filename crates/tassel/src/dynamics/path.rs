@@ -17,7 +17,8 @@ use glam::{Quat, Vec3};
 /// The last frames' character transforms and their times.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct CharacterPath {
-    /// Oldest first; the last `known` are valid (1..=4).
+    /// Oldest first; the last `known` are valid (0..=4; 0: nowhere yet, the next frame
+    /// is the first known).
     frames: [Transform; 4],
     /// `dts[i]`: seconds from `frames[i]` to `frames[i + 1]`.
     dts: [f32; 3],
@@ -25,8 +26,15 @@ pub(crate) struct CharacterPath {
 }
 
 impl Default for CharacterPath {
+    /// A path that knows nothing yet: its first frame is where the character starts,
+    /// whatever time step it comes with (so a first frame of `dt > 0` is a first frame of
+    /// `dt = 0`: no motion from a made-up earlier place).
     fn default() -> Self {
-        Self::new(Transform::IDENTITY)
+        Self {
+            frames: [Transform::IDENTITY; 4],
+            dts: [0.0; 3],
+            known: 0,
+        }
     }
 }
 
@@ -48,8 +56,9 @@ impl CharacterPath {
 
     /// This frame's transform, `dt` seconds after the last one (`dt = 0` replaces it).
     pub fn push(&mut self, at: Transform, dt: f32) {
-        if dt <= 0.0 {
-            if self.known == 1 {
+        if dt <= 0.0 || self.known == 0 {
+            if self.known <= 1 {
+                self.known = 1;
                 self.frames = [at; 4];
             } else {
                 self.frames[3] = at;

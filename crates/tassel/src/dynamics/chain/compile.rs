@@ -273,6 +273,12 @@ impl ChainRig {
         self.joint.len()
     }
 
+    /// The joints the chains turn (each chain joint with a simulated child, in write-back
+    /// order): the local rotations a frame writes, and nothing else.
+    pub fn rotator_joints(&self) -> impl Iterator<Item = usize> + '_ {
+        self.rotators.iter().map(|r| r.0 as usize)
+    }
+
     /// Number of chains.
     pub fn chain_count(&self) -> usize {
         self.chains.len()

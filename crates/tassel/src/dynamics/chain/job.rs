@@ -146,9 +146,13 @@ impl ChainState {
         self.in_lanes = to_lanes;
     }
 
-    /// Makes the next frame start again from the animated pose (velocities zero).
+    /// Makes the next frame start again from the animated pose (velocities zero), wherever
+    /// the character was before (its path is forgotten: that frame's time step changes
+    /// nothing).
     pub fn reset(&mut self) {
         self.needs_reset.iter_mut().for_each(|r| *r = true);
+        // Where the character was is no part of where it goes from here.
+        self.path = CharacterPath::default();
         self.lanes.iter_mut().for_each(ChainLanes::reset);
     }
 

@@ -129,6 +129,12 @@ impl VrmRig {
         Ok(rig)
     }
 
+    /// Whether the rig has `VRMC_node_constraint` constraints (they turn joints that are
+    /// not spring joints, from the animated pose, before the springs).
+    pub fn has_node_constraints(&self) -> bool {
+        !self.constraints.list.is_empty()
+    }
+
     /// Number of skeleton joints the rig was compiled for.
     pub fn joint_count(&self) -> usize {
         self.joint_count

@@ -109,9 +109,13 @@ impl VrmState {
         self.simd
     }
 
-    /// Makes the next frame start again from its pose (the spec's `reset`).
+    /// Makes the next frame start again from its pose (the spec's `reset`), wherever the
+    /// character was before (its path is forgotten: that frame's time step changes
+    /// nothing).
     pub fn reset(&mut self) {
         self.needs_reset = true;
+        // Where the character was is no part of where it goes from here.
+        self.path = CharacterPath::default();
     }
 
     /// The character was moved on purpose: start again instead of whipping.

@@ -22,5 +22,5 @@ pub(crate) mod step;
 pub(crate) mod twins;
 
 pub(crate) use frame::{any_planar, Ctx};
-pub(crate) use pack::{Pack, Scratch};
+pub(crate) use pack::{LaneState, Pack, Scratch};
 pub(crate) use step::LaneShape;

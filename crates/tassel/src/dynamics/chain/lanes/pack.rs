@@ -42,8 +42,9 @@ pub(crate) struct Pack {
     pub(crate) teleports: [u64; LANES],
     /// The local rotation each rotator joint got (per rotator).
     pub(crate) out_rotation: Vec<Q>,
-    /// The first bad input of the last frame (lane, error): the group was not stepped.
-    pub(crate) error: Option<(usize, Error)>,
+    /// The characters (crowd indices) whose input was bad in the last frame, and why:
+    /// their lanes were held (their state as before the frame).
+    pub(crate) held: Vec<(usize, Error)>,
     /// Every lane is the same character (twin chains of one character: one path, one
     /// transform, the same colliders): a lane's place on the path, placed colliders and
     /// motion are copied from an earlier lane that asked the same, not computed again;
@@ -89,7 +90,7 @@ impl Pack {
             prev_component: id,
             teleports: [0; LANES],
             out_rotation: vec![Q::splat(Quat::IDENTITY); rig.rotators.len()],
-            error: None,
+            held: Vec::new(),
             shared: false,
         }
     }

@@ -588,6 +588,8 @@ impl Twins {
     /// Every lane starts again from its pose on the next frame.
     pub(crate) fn reset(&mut self) {
         self.pack.needs_reset[0] = [true; LANES];
+        // As the scalar state's reset: the character's path so far is forgotten.
+        self.pack.paths = [CharacterPath::default(); LANES];
     }
 
     /// Resets in the lanes in use since they were loaded.

@@ -13,4 +13,4 @@ mod pack;
 pub(crate) mod springs;
 
 pub(crate) use frame::Ctx;
-pub(crate) use pack::{Pack, Plan, Scratch};
+pub(crate) use pack::{LaneState, Pack, Plan, Scratch};

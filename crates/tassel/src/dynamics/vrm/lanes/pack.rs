@@ -183,8 +183,9 @@ pub(crate) struct Pack {
     pub(crate) prev_component: Trs,
     pub(crate) needs_reset: [bool; LANES],
     pub(crate) resets: [u64; LANES],
-    /// The first bad input of the last frame (lane, error): the group was not stepped.
-    pub(crate) error: Option<(usize, Error)>,
+    /// The characters (crowd indices) whose input was bad in the last frame, and why:
+    /// their lanes were held (their state as before the frame).
+    pub(crate) held: Vec<(usize, Error)>,
 }
 
 impl Pack {
@@ -206,7 +207,7 @@ impl Pack {
             prev_component: Trs::splat(&Transform::IDENTITY),
             needs_reset: [true; LANES],
             resets: [0; LANES],
-            error: None,
+            held: Vec::new(),
         }
     }
 }
