@@ -57,7 +57,10 @@ fn setup(
     commands
         .spawn((
             WorldAssetRoot(assets.load(GltfAssetLabel::Scene(0).from_asset(FOX))),
-            SecondaryMotion::new(assets.load(FOX)).with_rig(assets.load("examples/rigs/fox.toml")),
+            // Its own sim (not a crowd of one) so that the gizmos can draw its chain.
+            SecondaryMotion::new(assets.load(FOX))
+                .with_rig(assets.load("examples/rigs/fox.toml"))
+                .without_crowd(),
             Walk(graphs.add(graph), walk),
             Transform::default(),
         ))

@@ -50,7 +50,8 @@ struct Sway {
 fn setup(mut commands: Commands, assets: Res<AssetServer>, avatar: Res<Avatar>) {
     commands.spawn((
         WorldAssetRoot(assets.load(GltfAssetLabel::Scene(0).from_asset(avatar.0.clone()))),
-        SecondaryMotion::new(assets.load(avatar.0.clone())),
+        // Its own sim (not a crowd of one) so that the gizmos can draw its springs.
+        SecondaryMotion::new(assets.load(avatar.0.clone())).without_crowd(),
         Transform::default(),
         Sway { offset: Vec3::ZERO },
     ));

@@ -11,6 +11,7 @@ use bevy::platform::collections::{HashMap, HashSet};
 use bevy::prelude::{ChildOf, Children, Name};
 use std::collections::VecDeque;
 use std::sync::{Arc, Weak};
+use tassel::crowd::CrowdKind;
 use tassel::dynamics::vrm::VrmSpringBones;
 use tassel::dynamics::{RigSettings, SimMode};
 use tassel::{CharacterRig, CharacterSim};
@@ -65,6 +66,7 @@ pub(crate) fn bind_characters(
     mut rig_events: MessageReader<AssetEvent<TasselRig>>,
     mut errors: MessageWriter<TasselError>,
     mut waiting: Local<Waiting>,
+    #[cfg(feature = "gltf")] scenes: Query<&bevy::world_serialization::WorldAssetRoot>,
 ) {
     // Hot reload: a changed model or rig restarts the characters that use it.
     let mut modified_models = HashSet::new();
@@ -131,6 +133,15 @@ pub(crate) fn bind_characters(
         let skeleton = model.skeleton();
         let root_name = model.entity_name(0).unwrap_or_default();
         let Some(_) = find_below(entity, root_name, &names, &children) else {
+            // A scene that failed to load will never bring the bones.
+            #[cfg(feature = "gltf")]
+            if let Ok(scene) = scenes.get(entity) {
+                if let LoadState::Failed(e) = server.load_state(&scene.0) {
+                    waiting.0.remove(&entity);
+                    fail(format!("the scene did not load: {e}"));
+                    continue;
+                }
+            }
             let n = waiting.0.entry(entity).or_default();
             *n += 1;
             if *n == WARN_AFTER_FRAMES {
@@ -193,13 +204,21 @@ pub(crate) fn bind_characters(
             .collect();
         let space = bones[0].and_then(|root| parents.get(root).ok().map(ChildOf::parent));
         let locals = skeleton.rest().to_vec();
+        // A kind that runs as a crowd steps there (the step system adds the character);
+        // any other, or a character asked to stay apart, on its own sim.
+        let sim = (!motion.crowd || CrowdKind::of(&compiled).is_none())
+            .then(|| CharacterSim::from_rig(compiled.clone()));
         commands.entity(entity).insert(TasselCharacter {
-            sim: CharacterSim::from_rig(compiled),
+            rig: compiled,
+            sim,
+            slot: None,
             bones,
             space,
             first_frame: true,
             last_error: None,
             locals,
+            root: tassel::Transform::IDENTITY,
+            result: None,
             wrote: vec![None; written.len()],
             written,
         });

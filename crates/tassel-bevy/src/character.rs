@@ -5,8 +5,9 @@ use crate::assets::{TasselModel, TasselRig};
 use bevy::asset::Handle;
 use bevy::ecs::component::Component;
 use bevy::ecs::entity::Entity;
+use std::sync::Arc;
 use tassel::dynamics::SimMode;
-use tassel::CharacterSim;
+use tassel::{CharacterRig, CharacterSim, Skeleton};
 
 /// Secondary motion for the hierarchy under this entity: put it on the entity that holds
 /// a glTF/VRM scene (`WorldAssetRoot`, formerly `SceneRoot`) or on the root of any
@@ -15,6 +16,12 @@ use tassel::CharacterSim;
 /// (shared with every character of the same model, rig and mode) and adds a
 /// [`TasselCharacter`]; from then on it reads the animated bone `Transform`s each frame,
 /// steps, and writes the simulated bones back before transform propagation.
+///
+/// Characters of one kind (the same model, rig and mode) whose only solver is VRM spring
+/// bones, or bone chains, are stepped together in a crowd ([`tassel::crowd`]: SIMD lanes,
+/// every core), bit for bit as one [`CharacterSim`] each; other kinds step one
+/// `CharacterSim` per character, characters in parallel. `without_crowd` keeps a
+/// character on its own `CharacterSim` (to read its solver states: [`TasselCharacter::sim`]).
 ///
 /// Changing any field starts the character again (new rig, new mode).
 #[derive(Component, Debug, Clone)]
@@ -28,6 +35,9 @@ pub struct SecondaryMotion {
     pub mode: SimMode,
     /// Run the file's VRM spring bones (default `true`).
     pub vrm_springs: bool,
+    /// Step with the other characters of its kind in a crowd where the kind allows
+    /// (default `true`); `false` keeps its own [`CharacterSim`].
+    pub crowd: bool,
 }
 
 impl SecondaryMotion {
@@ -38,6 +48,7 @@ impl SecondaryMotion {
             rig: None,
             mode: SimMode::Fixed,
             vrm_springs: true,
+            crowd: true,
         }
     }
 
@@ -58,15 +69,28 @@ impl SecondaryMotion {
         self.vrm_springs = false;
         self
     }
+
+    /// Keeps this character on its own [`CharacterSim`] (never in a crowd), so that
+    /// [`TasselCharacter::sim`] gives its solver states (the gizmos draw from them).
+    pub fn without_crowd(mut self) -> Self {
+        self.crowd = false;
+        self
+    }
 }
 
 /// The running simulation of a [`SecondaryMotion`] entity, added by the plugin once the
-/// bones are found. Read results through [`sim`](Self::sim) (world space: bone
-/// transforms, chain tips, VRM tails); [`reset`](Self::reset) and
+/// bones are found. The simulated bones' `Transform`s are the results (and, after
+/// propagation, their `GlobalTransform`s); a character on its own [`CharacterSim`] also
+/// gives its solver states through [`sim`](Self::sim). [`reset`](Self::reset) and
 /// [`teleport`](Self::teleport) restart the motion from the animated pose.
 #[derive(Component, Debug)]
 pub struct TasselCharacter {
-    pub(crate) sim: CharacterSim,
+    /// The compiled kind (shared by every character of the same model, rig and mode).
+    pub(crate) rig: Arc<CharacterRig>,
+    /// The character's own simulation (`None`: stepped in its kind's crowd).
+    pub(crate) sim: Option<CharacterSim>,
+    /// Its index in its kind's crowd, once it joined (crowd path only).
+    pub(crate) slot: Option<usize>,
     /// Joint → the entity that stands for it (`None`: not found, rest pose used).
     pub(crate) bones: Vec<Option<Entity>>,
     /// The simulated joints that have an entity: written back each frame.
@@ -78,8 +102,13 @@ pub struct TasselCharacter {
     pub(crate) first_frame: bool,
     /// The last frame's error, reported once until it changes.
     pub(crate) last_error: Option<String>,
-    /// The animated local pose as last seen (what the solvers start from).
+    /// The animated local pose as last seen (what its own sim reads; a crowd member's is
+    /// in its kind's buffer).
     pub(crate) locals: Vec<tassel::Transform>,
+    /// This frame's world transform of the skeleton's model space (its own sim's input).
+    pub(crate) root: tassel::Transform,
+    /// This frame's error, between the step and the write-back.
+    pub(crate) result: Option<String>,
     /// What the plugin wrote into each of `written` last frame: a bone still holding it
     /// was not animated since, and keeps its last animated pose as input (no feedback of
     /// the simulated pose into the next frame's input).
@@ -87,14 +116,46 @@ pub struct TasselCharacter {
 }
 
 impl TasselCharacter {
-    /// The simulation: its pose, states and world-space results as of the last frame.
-    pub fn sim(&self) -> &CharacterSim {
-        &self.sim
+    /// The character's own simulation (its pose, solver states and world-space results as
+    /// of the last frame); `None` for a character stepped in a crowd (see
+    /// [`SecondaryMotion::without_crowd`]).
+    pub fn sim(&self) -> Option<&CharacterSim> {
+        self.sim.as_ref()
+    }
+
+    /// The compiled kind of character: skeleton, solvers, simulated joints.
+    pub fn rig(&self) -> &Arc<CharacterRig> {
+        &self.rig
+    }
+
+    /// The model's skeleton (joint names and parents).
+    pub fn skeleton(&self) -> &Skeleton {
+        self.rig.skeleton()
+    }
+
+    /// The joints the solvers write, ascending.
+    pub fn simulated_joints(&self) -> &[usize] {
+        self.rig.simulated_joints()
+    }
+
+    /// The simulated bones' entities with their joints: the `Transform`s the plugin writes
+    /// each frame.
+    pub fn simulated_bones(&self) -> &[(usize, Entity)] {
+        &self.written
+    }
+
+    /// Whether the character is stepped in its kind's crowd (not on its own
+    /// [`CharacterSim`]).
+    pub fn in_crowd(&self) -> bool {
+        self.sim.is_none()
     }
 
     /// The entity that stands for the bone called `name`, if it was found.
     pub fn bone_entity(&self, name: &str) -> Option<Entity> {
-        self.bones.get(self.sim.bone(name)?).copied().flatten()
+        self.bones
+            .get(self.skeleton().find(name)?)
+            .copied()
+            .flatten()
     }
 
     /// The entity whose world transform is the skeleton's model space (the parent of the

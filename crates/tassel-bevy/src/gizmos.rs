@@ -28,8 +28,9 @@ const CHAIN: Color = Color::srgb(0.2, 0.9, 1.0);
 const SPRING: Color = Color::srgb(1.0, 0.3, 0.9);
 
 fn draw(mut gizmos: Gizmos, characters: Query<&TasselCharacter>) {
-    for character in &characters {
-        let sim = character.sim();
+    // Characters stepped in a crowd have no sim of their own to draw from
+    // (`SecondaryMotion::without_crowd` keeps one).
+    for sim in characters.iter().filter_map(TasselCharacter::sim) {
         let component = sim.component();
         // Chains: points (model space) and the links to their parents.
         let chains = sim.chains();

@@ -47,6 +47,7 @@ mod assets;
 mod bind;
 mod character;
 mod controller;
+mod crowd;
 #[cfg(feature = "gizmos")]
 mod gizmos;
 mod step;
@@ -58,6 +59,7 @@ pub use character::{SecondaryMotion, TasselCharacter, TasselFailed};
 pub use controller::{CharacterController, TasselCollider, TasselLevel};
 #[cfg(feature = "gizmos")]
 pub use gizmos::TasselGizmosPlugin;
+pub use step::STEP_TIME;
 pub use tassel;
 pub use tassel::dynamics::SimMode;
 #[cfg(feature = "gltf")]
@@ -65,6 +67,7 @@ pub use vrm_scene::VrmSceneLoader;
 
 use bevy::app::{AnimationSystems, App, Plugin, PostUpdate};
 use bevy::asset::AssetApp;
+use bevy::diagnostic::RegisterDiagnostic;
 use bevy::ecs::prelude::*;
 use bevy::transform::TransformSystems;
 
@@ -117,6 +120,8 @@ impl Plugin for TasselPlugin {
             .register_asset_loader(TasselRigLoader)
             .add_message::<TasselError>()
             .init_resource::<bind::RigCache>()
+            .init_resource::<crowd::Crowds>()
+            .register_diagnostic(step::step_time_diagnostic())
             .init_resource::<TasselLevel>()
             .configure_sets(
                 PostUpdate,

@@ -1,12 +1,32 @@
 //! One frame of every bound character: read the animated bone `Transform`s, step, write
 //! the simulated bones back (before Bevy propagates transforms).
+//!
+//! Three passes. **Read**: each character's animated bones and its world transform into
+//! its input buffer (its own, or its slot of its kind's crowd). **Step**: every crowd
+//! (SIMD lanes, the rayon pool's threads), and the characters on their own
+//! `CharacterSim` in parallel on Bevy's compute pool. **Write**: each character's
+//! simulated bones back to their entities. Only the passes that touch `Transform`s are
+//! sequential, and they touch only the bones a solver reads or writes.
 
 use crate::character::TasselCharacter;
+use crate::crowd::Crowds;
 use crate::TasselError;
+use bevy::diagnostic::{Diagnostic, DiagnosticPath, Diagnostics};
 use bevy::ecs::prelude::*;
 use bevy::log::warn;
 use bevy::prelude::{ChildOf, Transform};
 use bevy::time::Time;
+use std::time::Instant;
+
+/// The plugin's time per frame in [`TasselSystems::Step`](crate::TasselSystems::Step)
+/// (reading, stepping and writing every character), milliseconds: a diagnostic in Bevy's
+/// `DiagnosticsStore`.
+pub const STEP_TIME: DiagnosticPath = DiagnosticPath::const_new("tassel/step_ms");
+
+/// The same diagnostic registered with its unit.
+pub(crate) fn step_time_diagnostic() -> Diagnostic {
+    Diagnostic::new(STEP_TIME).with_suffix(" ms")
+}
 
 /// Bevy's `Transform` as Tassel's (the same glam types).
 pub(crate) fn to_tassel(t: &Transform) -> tassel::Transform {
@@ -37,69 +57,191 @@ pub(crate) fn world_of(
     world.unwrap_or(tassel::Transform::IDENTITY)
 }
 
+/// Reads character `c`'s animated pose into `locals` (only `joints`, or every joint when
+/// `None`): every bone's Transform as the animation left it. A simulated bone that still
+/// holds what the plugin wrote last frame was not animated since (no clip drives it): it
+/// keeps its last animated pose. A bone without an entity stays at rest.
+fn read_pose(
+    c: &TasselCharacter,
+    joints: Option<&[usize]>,
+    locals: &mut [tassel::Transform],
+    transforms: &Query<&mut Transform>,
+) {
+    let mut read = |j: usize, mine: Option<tassel::Transform>| {
+        if let Some(t) = c.bones[j].and_then(|e| transforms.get(e).ok()) {
+            let t = to_tassel(t);
+            if mine != Some(t) {
+                locals[j] = t;
+            }
+        }
+    };
+    // `written` is ascending by joint, as `joints` and `0..n` are: one merge walk.
+    let mut w = 0;
+    let mut mine = |j: usize| {
+        while c.written.get(w).is_some_and(|&(k, _)| k < j) {
+            w += 1;
+        }
+        match c.written.get(w) {
+            Some(&(k, _)) if k == j => c.wrote[w],
+            _ => None,
+        }
+    };
+    match joints {
+        Some(joints) => joints.iter().for_each(|&j| read(j, mine(j))),
+        None => (0..c.bones.len()).for_each(|j| read(j, mine(j))),
+    }
+}
+
+/// Writes the simulated joints of `pose` to character `c`'s bones.
+fn write_pose(
+    c: &mut TasselCharacter,
+    pose: &[tassel::Transform],
+    transforms: &mut Query<&mut Transform>,
+) {
+    for (&(j, e), wrote) in c.written.iter().zip(&mut c.wrote) {
+        if let Ok(mut t) = transforms.get_mut(e) {
+            let l = pose[j];
+            t.translation = l.translation;
+            t.rotation = l.rotation;
+            t.scale = l.scale;
+            *wrote = Some(l);
+        }
+    }
+}
+
+/// Reports a frame error once until it changes; the bones keep their animated pose.
+fn report(
+    entity: Entity,
+    c: &mut TasselCharacter,
+    message: String,
+    errors: &mut MessageWriter<TasselError>,
+) {
+    if c.last_error.as_deref() != Some(message.as_str()) {
+        warn!("tassel: entity {entity}: frame skipped: {message}");
+        errors.write(TasselError {
+            entity,
+            message: message.clone(),
+        });
+        c.last_error = Some(message);
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn step_characters(
     time: Res<Time>,
     mut characters: Query<(Entity, &mut TasselCharacter)>,
     mut transforms: Query<&mut Transform>,
     parents: Query<&ChildOf>,
     mut errors: MessageWriter<TasselError>,
+    mut crowds: ResMut<Crowds>,
+    mut removed: RemovedComponents<TasselCharacter>,
+    mut held: Local<Vec<(usize, tassel::Error)>>,
+    mut diagnostics: Diagnostics,
 ) {
+    let started = Instant::now();
     let dt = time.delta_secs();
-    for (entity, mut character) in &mut characters {
-        let c = &mut *character;
-        // The animated pose: every bone's Transform as the animation left it. A simulated
-        // bone that still holds what the plugin wrote last frame was not animated since
-        // (no clip drives it): it keeps its last animated pose. A bone without an entity
-        // stays at rest.
-        let mut w = 0;
-        for (j, local) in c.locals.iter_mut().enumerate() {
-            let mine = match c.written.get(w) {
-                Some(&(k, _)) if k == j => {
-                    w += 1;
-                    c.wrote[w - 1]
-                }
-                _ => None,
-            };
-            if let Some(t) = c.bones[j].and_then(|e| transforms.get(e).ok()) {
-                let t = to_tassel(t);
-                if mine != Some(t) {
-                    *local = t;
-                }
+    let crowds = &mut *crowds;
+    // Characters gone (despawned, or rebound with another rig or mode) leave their crowd;
+    // the member that takes a leaver's index follows it.
+    for entity in removed.read() {
+        if let Some((moved, i)) = crowds.leave(entity) {
+            if let Ok((_, mut c)) = characters.get_mut(moved) {
+                c.slot = Some(i);
             }
         }
-        let component = world_of(c.space, &transforms, &parents);
+    }
+    // New crowd members join (a character whose kind runs as a crowd has no sim of its
+    // own: bind left it `None`).
+    for (entity, mut c) in &mut characters {
+        if c.sim.is_none() && c.slot.is_none() {
+            let rig = c.rig.clone();
+            match crowds.join(entity, &rig) {
+                Some(i) => c.slot = Some(i),
+                // Not a crowd after all (its crowd failed to build): its own sim.
+                None => c.sim = Some(tassel::CharacterSim::from_rig(rig)),
+            }
+        }
+    }
+    // Read.
+    for (entity, mut c) in &mut characters {
+        let c = &mut *c;
+        let root = world_of(c.space, &transforms, &parents);
+        match c.slot {
+            Some(i) => {
+                let Some(&(k, _)) = crowds.members.get(&entity) else {
+                    continue;
+                };
+                let kind = crowds.kinds.get_mut(&k).expect("a member's kind exists");
+                let read = std::mem::take(&mut kind.read);
+                read_pose(c, Some(&read), kind.locals_mut(i), &transforms);
+                kind.read = read;
+                kind.roots[i] = root;
+                if c.first_frame {
+                    kind.reset(i);
+                    c.first_frame = false;
+                }
+            }
+            None => {
+                let mut locals = std::mem::take(&mut c.locals);
+                read_pose(c, None, &mut locals, &transforms);
+                c.locals = locals;
+                c.root = root;
+            }
+        }
+    }
+    // Step: the characters on their own sims in parallel, then each crowd (rayon).
+    characters.par_iter_mut().for_each(|(_, mut c)| {
+        let c = &mut *c;
+        let Some(sim) = c.sim.as_mut() else {
+            return;
+        };
         let dt = if c.first_frame {
-            c.sim.reset();
+            sim.reset();
             0.0
         } else {
             dt
         };
-        match c.sim.frame(&c.locals, component, dt) {
-            Ok(pose) => {
-                c.first_frame = false;
-                c.last_error = None;
-                for (&(j, e), wrote) in c.written.iter().zip(&mut c.wrote) {
-                    if let Ok(mut t) = transforms.get_mut(e) {
-                        let l = pose.locals[j];
-                        t.translation = l.translation;
-                        t.rotation = l.rotation;
-                        t.scale = l.scale;
-                        *wrote = Some(l);
-                    }
-                }
-            }
-            Err(e) => {
-                // The bones keep their animated pose; the next good frame carries on.
-                let message = e.to_string();
-                if c.last_error.as_deref() != Some(message.as_str()) {
-                    warn!("tassel: entity {entity}: frame skipped: {message}");
-                    errors.write(TasselError {
-                        entity,
-                        message: message.clone(),
-                    });
-                    c.last_error = Some(message);
-                }
+        c.result = sim
+            .frame(&c.locals, c.root, dt)
+            .err()
+            .map(|e| e.to_string());
+        if c.result.is_none() {
+            c.first_frame = false;
+        }
+    });
+    for kind in crowds.kinds.values_mut() {
+        kind.frame(dt, &mut held);
+        for (i, e) in held.drain(..) {
+            let entity = kind.members[i];
+            if let Ok((_, mut c)) = characters.get_mut(entity) {
+                c.result = Some(e.to_string());
             }
         }
     }
+    // Write.
+    for (entity, mut c) in &mut characters {
+        let c = &mut *c;
+        if let Some(message) = c.result.take() {
+            report(entity, c, message, &mut errors);
+            continue;
+        }
+        c.last_error = None;
+        match (c.slot, &c.sim) {
+            (Some(i), _) => {
+                let Some(&(k, _)) = crowds.members.get(&entity) else {
+                    continue;
+                };
+                let kind = crowds.kinds.get_mut(&k).expect("a member's kind exists");
+                let pose = kind.output(i);
+                write_pose(c, pose, &mut transforms);
+            }
+            (None, Some(_)) => {
+                let sim = c.sim.take().expect("checked");
+                write_pose(c, &sim.pose().locals, &mut transforms);
+                c.sim = Some(sim);
+            }
+            (None, None) => {}
+        }
+    }
+    diagnostics.add_measurement(&STEP_TIME, || started.elapsed().as_secs_f64() * 1e3);
 }

@@ -50,6 +50,18 @@ fn gltf_app(folder: &str) -> App {
 }
 
 fn spawn_scene(app: &mut App, file: &str, mode: SimMode) -> Entity {
+    spawn_scene_with(app, file, mode, None, true)
+}
+
+/// A scene of `file` with its VRM springs (or the rig file `rig`), in its kind's crowd or
+/// on its own sim.
+fn spawn_scene_with(
+    app: &mut App,
+    file: &str,
+    mode: SimMode,
+    rig: Option<&Handle<TasselRig>>,
+    crowd: bool,
+) -> Entity {
     let server = app.world().resource::<AssetServer>().clone();
     let scene: Handle<WorldAsset> = server
         .load_builder()
@@ -62,12 +74,15 @@ fn spawn_scene(app: &mut App, file: &str, mode: SimMode) -> Entity {
         })
         .load(GltfAssetLabel::Scene(0).from_asset(file.to_string()));
     let model = server.load::<TasselModel>(file.to_string());
+    let mut motion = SecondaryMotion::new(model).with_mode(mode);
+    if let Some(rig) = rig {
+        motion = motion.with_rig(rig.clone());
+    }
+    if !crowd {
+        motion = motion.without_crowd();
+    }
     app.world_mut()
-        .spawn((
-            WorldAssetRoot(scene),
-            SecondaryMotion::new(model).with_mode(mode),
-            Transform::default(),
-        ))
+        .spawn((WorldAssetRoot(scene), motion, Transform::default()))
         .id()
 }
 
@@ -142,11 +157,13 @@ fn vrm_files_spawned_by_bevy_move_as_character_sim_moves_them() {
                 CharacterSim::with_vrm(model.skeleton.clone(), &rig, &springs, options).unwrap();
             let (bones, space, joints) = {
                 let c = app.world().get::<TasselCharacter>(character).unwrap();
-                let sk = c.sim().skeleton();
+                // VRM-only kinds step in a crowd: no sim of their own.
+                assert!(c.in_crowd() && c.sim().is_none(), "{file}: in a crowd");
+                let sk = c.skeleton();
                 let bones: Vec<Entity> = (0..sk.len())
                     .map(|j| c.bone_entity(sk.name(j)).expect("every node has an entity"))
                     .collect();
-                (bones, c.space(), c.sim().simulated_joints().to_vec())
+                (bones, c.space(), c.simulated_joints().to_vec())
             };
             assert!(!joints.is_empty());
             // Both start from the pose on the next frame (the plugin has run since binding).
@@ -222,4 +239,146 @@ fn vrm_files_spawned_by_bevy_move_as_character_sim_moves_them() {
         }
     }
     assert_eq!(tested, 2 * files.len());
+}
+
+/// Moves its entity on the test path, `phase` seconds ahead.
+#[derive(Component, Clone, Copy)]
+struct Phase(f64);
+
+fn move_by_phase(time: Res<Time>, mut q: Query<(&mut Transform, &Phase)>) {
+    for (mut t, phase) in &mut q {
+        *t = bevy_transform(&path(time.elapsed_secs_f64() + phase.0));
+    }
+}
+
+/// The bits of a `Transform`.
+fn bits(t: &Transform) -> [u32; 10] {
+    let mut b = [0u32; 10];
+    let values = t
+        .translation
+        .to_array()
+        .into_iter()
+        .chain(t.rotation.to_array())
+        .chain(t.scale.to_array());
+    for (k, v) in values.enumerate() {
+        b[k] = v.to_bits();
+    }
+    b
+}
+
+/// Characters of one kind in its crowd give the bones, bit for bit, that the same
+/// characters on their own `CharacterSim`s give (each crowd character has a twin without
+/// the crowd, on the same path): every VRM file (a `VrmCrowd`) and Fox.glb with a chain
+/// rig (a `ChainCrowd`), characters joining on different frames and one leaving mid-run.
+#[test]
+fn crowd_characters_move_as_their_own_sims_move_them() {
+    let Some(root) = testdata() else { return };
+    let mut cases: Vec<(String, Option<tassel::dynamics::RigSettings>)> =
+        std::fs::read_dir(root.join("vrm"))
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .filter(|n| n.ends_with(".vrm") || n.ends_with(".gltf"))
+            .map(|n| (format!("vrm/{n}"), None))
+            .collect();
+    cases.sort_by(|a, b| a.0.cmp(&b.0));
+    // The fox's tail as a bone chain (the rig file of the repository, added as an asset).
+    let fox = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/rigs/fox.toml");
+    let fox = tassel::dynamics::RigSettings::from_toml_str(&std::fs::read_to_string(fox).unwrap())
+        .unwrap();
+    cases.push(("gltf/Fox.glb".into(), Some(fox)));
+    let mut crowds_seen = 0;
+    for (file, rig) in &cases {
+        let mut app = gltf_app(root.to_str().unwrap());
+        app.add_systems(Update, move_by_phase);
+        let rig = rig.clone().map(|r| {
+            app.world_mut()
+                .resource_mut::<Assets<TasselRig>>()
+                .add(TasselRig(r))
+        });
+        // Pairs (crowd, own sim), spawned on frames 0, 5 and 12; pair 1 leaves on frame 60.
+        let mut pairs: Vec<(Entity, Entity)> = Vec::new();
+        let mut compared = 0usize;
+        let mut swing = 0.0f32;
+        for frame in 0..150 {
+            if [0, 5, 12].contains(&frame) {
+                let phase = Phase(0.37 * pairs.len() as f64);
+                let a = spawn_scene_with(&mut app, file, SimMode::Fixed, rig.as_ref(), true);
+                let b = spawn_scene_with(&mut app, file, SimMode::Fixed, rig.as_ref(), false);
+                app.world_mut().entity_mut(a).insert(phase);
+                app.world_mut().entity_mut(b).insert(phase);
+                pairs.push((a, b));
+            }
+            if frame == 60 {
+                let (a, b) = pairs.remove(1);
+                app.world_mut().entity_mut(a).despawn();
+                app.world_mut().entity_mut(b).despawn();
+            }
+            app.update();
+            let world = app.world();
+            for &(a, b) in &pairs {
+                let (Some(ca), Some(cb)) = (
+                    world.get::<TasselCharacter>(a),
+                    world.get::<TasselCharacter>(b),
+                ) else {
+                    if let Some(f) = world.get::<TasselFailed>(a) {
+                        panic!("{file}: {}", f.0);
+                    }
+                    continue;
+                };
+                assert!(ca.in_crowd(), "{file}: the crowd character is in a crowd");
+                assert!(!cb.in_crowd(), "{file}: its twin is not");
+                assert_eq!(ca.simulated_bones().len(), cb.simulated_bones().len());
+                for (&(j, ea), &(k, eb)) in ca.simulated_bones().iter().zip(cb.simulated_bones()) {
+                    assert_eq!(j, k);
+                    let (ta, tb) = (
+                        world.get::<Transform>(ea).unwrap(),
+                        world.get::<Transform>(eb).unwrap(),
+                    );
+                    assert_eq!(
+                        bits(ta),
+                        bits(tb),
+                        "{file} frame {frame}: joint '{}': crowd {ta:?}, own sim {tb:?}",
+                        ca.skeleton().name(j)
+                    );
+                    let rest = ca.skeleton().rest()[j].rotation;
+                    swing = swing.max(ta.rotation.angle_between(rest));
+                    compared += 1;
+                }
+            }
+        }
+        assert!(compared > 1000, "{file}: {compared} bones compared");
+        assert!(swing > 0.01, "{file}: the bones swing ({swing} rad)");
+        crowds_seen += 1;
+    }
+    assert_eq!(crowds_seen, cases.len());
+}
+
+/// A scene that fails to load (here: a file that does not exist) gives `TasselFailed` with
+/// the loader's message, not an endless wait, while the model loaded fine.
+#[test]
+fn a_scene_that_fails_to_load_is_reported() {
+    let Some(root) = testdata() else { return };
+    let mut app = gltf_app(root.to_str().unwrap());
+    let server = app.world().resource::<AssetServer>().clone();
+    let scene: Handle<WorldAsset> =
+        server.load(GltfAssetLabel::Scene(0).from_asset("vrm/no_such_file.vrm"));
+    let model = server.load::<TasselModel>("vrm/smoke_spring.vrm");
+    let character = app
+        .world_mut()
+        .spawn((
+            WorldAssetRoot(scene),
+            SecondaryMotion::new(model),
+            Transform::default(),
+        ))
+        .id();
+    let failed = update_until(&mut app, 600, |app| {
+        app.world().get::<TasselFailed>(character).is_some()
+    });
+    assert!(failed, "no TasselFailed after 600 frames");
+    let message = &app.world().get::<TasselFailed>(character).unwrap().0;
+    assert!(
+        message.contains("scene") && message.contains("no_such_file"),
+        "{message}"
+    );
+    assert!(app.world().get::<TasselCharacter>(character).is_none());
 }
