@@ -11,6 +11,22 @@
 //!   ([`ExportSource::add_body`]).
 //! - [`bake_clip`]: play a clip through a [`tassel::CharacterSim`] and key the bones it
 //!   simulates.
+//!
+//! A skeleton written as a GLB and read back (a file works the same: [`load`] takes its
+//! path):
+//!
+//! ```
+//! use tassel_gltf::{export_glb, load_slice, BoneMesh, ExportSource};
+//!
+//! let character = tassel::builtin::character();
+//! let source = ExportSource::from_skeleton(&character.skeleton, BoneMesh::Octahedra);
+//! let glb = export_glb(&source, &[])?;
+//! let model = load_slice(&glb, None, "character.glb")?;
+//! assert_eq!(model.skeleton.len(), character.skeleton.len());
+//! let head = model.skeleton.find("head").expect("the built-in character has a head");
+//! assert_eq!(model.skeleton.name(head), "head");
+//! # Ok::<(), tassel_gltf::GltfError>(())
+//! ```
 
 /// The core crate, re-exported (and with it `tassel::glam`).
 pub use tassel;

@@ -25,6 +25,26 @@
 //!
 //! The core does no file I/O.
 //!
+//! One character, one frame at a time:
+//!
+//! ```
+//! use tassel::{builtin, CharacterSim, Transform};
+//!
+//! let character = builtin::character(); // or tassel_gltf::load(path) and a rig file
+//! let mut sim = CharacterSim::new(character.skeleton.clone(), &character.rig)?;
+//! let animated = character.skeleton.rest().to_vec(); // each frame: your animated local pose
+//! let joints = sim.simulated_joints().to_vec(); // the bones the solvers move
+//! for frame in 0..120 {
+//!     let at = Transform::from_translation(tassel::glam::Vec3::X * 0.02 * frame as f32);
+//!     let dt = if frame == 0 { 0.0 } else { 1.0 / 60.0 }; // frame 0 places the solvers
+//!     let pose = sim.frame(&animated, at, dt)?; // the simulated bones written in
+//!     for &j in &joints {
+//!         let _local = pose.locals[j]; // copy these back to your engine's bones
+//!     }
+//! }
+//! # Ok::<(), tassel::Error>(())
+//! ```
+//!
 //! ## Units and conventions
 //! - Lengths in metres, times in seconds, Y up, right-handed (glTF's frame).
 //! - **Angles in degrees** wherever a person types or reads one: rig files and every

@@ -21,7 +21,7 @@ pub enum SimdUse {
 /// The lane code a [`SimdUse`] runs on this CPU ([`Isa::of`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Isa {
-    /// [`lanes::F`]: plain Rust, vectorised by the compiler for the baseline target.
+    /// [`F`](super::F): plain Rust, vectorised by the compiler for the baseline target.
     Portable,
     /// The AVX2 lane type (`lanes/avx.rs`); only ever made where the CPU has AVX2.
     Avx2,
