@@ -19,7 +19,7 @@
 //! use tassel_gltf::{export_glb, load_slice, BoneMesh, ExportSource};
 //!
 //! let character = tassel::builtin::character();
-//! let source = ExportSource::from_skeleton(&character.skeleton, BoneMesh::Octahedra);
+//! let source = ExportSource::from_skeleton(&character.skeleton, BoneMesh::None);
 //! let glb = export_glb(&source, &[])?;
 //! let model = load_slice(&glb, None, "character.glb")?;
 //! assert_eq!(model.skeleton.len(), character.skeleton.len());
