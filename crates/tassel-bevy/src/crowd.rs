@@ -142,12 +142,21 @@ impl Kind {
         }
     }
 
-    /// Member `i`'s simulated local pose: its animated locals with the solvers' rotations
-    /// (every joint; only the simulated ones differ from the input).
-    pub(crate) fn output(&mut self, i: usize) -> &[Transform] {
+    /// Member `i`'s simulated local pose: its animated locals with the solvers' rotations.
+    /// Only the joints of `written` (simulated joints, ascending) are fresh; the others
+    /// hold whatever an earlier member left (the write-back reads no other).
+    pub(crate) fn output(&mut self, i: usize, written: &[(usize, Entity)]) -> &[Transform] {
         let n = self.joints();
         let input = &self.locals[i * n..(i + 1) * n];
-        self.scratch_locals.copy_from_slice(input);
+        if self.whole_pose {
+            self.scratch_locals.copy_from_slice(input);
+        } else {
+            // The crowd turns simulated joints only: their animated translation and scale
+            // are the output's, and their rotation is written below.
+            for &(j, _) in written {
+                self.scratch_locals[j] = input[j];
+            }
+        }
         let out = &mut self.scratch_locals;
         let _ = match &self.run {
             Run::Vrm(c) if self.whole_pose => c.write_pose(i, out, &mut self.scratch_models),

@@ -232,7 +232,7 @@ pub(crate) fn step_characters(
                     continue;
                 };
                 let kind = crowds.kinds.get_mut(&k).expect("a member's kind exists");
-                let pose = kind.output(i);
+                let pose = kind.output(i, &c.written);
                 write_pose(c, pose, &mut transforms);
             }
             (None, Some(_)) => {
