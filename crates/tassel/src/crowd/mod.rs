@@ -137,20 +137,13 @@ fn restore<P: Group>(pack: &mut P, kept: Vec<(usize, P::Lane)>) {
 }
 
 /// Swaps the characters in lanes `i` and `j` of a crowd's lane groups ([`lanes::LANES`]
-/// characters each, in index order): `take` copies one lane's state out, `put` writes
-/// it into a lane.
-fn swap_lanes<P, S>(
-    packs: &mut [P],
-    i: usize,
-    j: usize,
-    take: impl Fn(&mut P, usize) -> S,
-    put: impl Fn(&mut P, usize, &S),
-) {
+/// characters each, in index order), through [`Group`]'s `take` and `put`.
+fn swap_lanes<P: Group>(packs: &mut [P], i: usize, j: usize) {
     use lanes::LANES;
     if i != j {
-        let a = take(&mut packs[i / LANES], i % LANES);
-        let b = take(&mut packs[j / LANES], j % LANES);
-        put(&mut packs[i / LANES], i % LANES, &b);
-        put(&mut packs[j / LANES], j % LANES, &a);
+        let a = packs[i / LANES].take(i % LANES);
+        let b = packs[j / LANES].take(j % LANES);
+        packs[i / LANES].put(i % LANES, &b);
+        packs[j / LANES].put(j % LANES, &a);
     }
 }

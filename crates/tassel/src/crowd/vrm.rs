@@ -146,7 +146,7 @@ impl VrmCrowd {
     pub fn swap(&mut self, i: usize, j: usize) -> Result<()> {
         self.check(i)?;
         self.check(j)?;
-        super::swap_lanes(&mut self.packs, i, j, |p, l| p.lane(l), Pack::set_lane);
+        super::swap_lanes(&mut self.packs, i, j);
         Ok(())
     }
 
