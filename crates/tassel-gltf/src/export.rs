@@ -14,7 +14,8 @@ pub struct ExportSource {
     pub json: Value,
     /// The bytes of each buffer in `json["buffers"]`.
     pub buffers: Vec<Vec<u8>>,
-    /// Where relative image URIs are resolved.
+    /// Where relative image URIs are resolved (`None`: nowhere; an external image is an
+    /// error naming its URI).
     pub base_dir: Option<PathBuf>,
 }
 

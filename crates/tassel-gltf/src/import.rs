@@ -78,7 +78,9 @@ pub fn load(path: &Path) -> Result<Model, GltfError> {
 /// together (512 MiB).
 pub const MAX_FILE_BYTES: usize = 512 << 20;
 
-/// Loads from bytes; `base_dir` resolves external buffers; `name` is used in messages.
+/// Loads from bytes; `base_dir` resolves external buffers (`None`: the bytes are all
+/// there is, and a buffer in an external file is an error naming its URI; data: URIs and
+/// GLB chunks work either way); `name` is used in messages.
 pub fn load_slice(bytes: &[u8], base_dir: Option<&Path>, name: &str) -> Result<Model, GltfError> {
     let invalid = |message: String| GltfError::Invalid {
         path: name.to_string(),

@@ -23,7 +23,9 @@ pub(crate) fn read_at_most(path: &Path, limit: usize) -> std::io::Result<Vec<u8>
 
 /// A buffer's bytes from its URI: a base64 data URI, or a file beside the glTF file
 /// (relative, inside its folder: no absolute path, no `..`, no other scheme), of which at
-/// most `length` bytes (the buffer's `byteLength`) are read.
+/// most `length` bytes (the buffer's `byteLength`) are read. Without a folder
+/// (`base_dir` `None`: bytes from memory) no file is read: an external URI is an error
+/// that names it.
 pub(crate) fn read_uri(
     uri: &str,
     base_dir: Option<&Path>,
@@ -51,7 +53,14 @@ pub(crate) fn read_uri(
             head(uri, 80)
         ));
     }
-    let path = base_dir.unwrap_or(Path::new(".")).join(relative);
+    let Some(base_dir) = base_dir else {
+        return Err(format!(
+            "buffer URI '{}' is an external file, and bytes loaded from memory read no \
+             files: embed the buffer (a GLB, or a data: URI) or load the file from its path",
+            head(uri, 80)
+        ));
+    };
+    let path = base_dir.join(relative);
     // At most the declared bytes: a longer file keeps its tail (it may be padded).
     read_at_most(&path, length).map_err(|e| format!("buffer '{}': {e}", path.display()))
 }
@@ -117,6 +126,16 @@ mod tests {
             let e = read_uri(uri, Some(Path::new("/tmp")), 10).unwrap_err();
             assert!(e.contains("relative path inside"), "{uri}: {e}");
         }
+    }
+
+    #[test]
+    fn bytes_from_memory_read_no_file() {
+        // A file that exists where a relative path would find it (the crate's folder is
+        // the test's working directory): still refused, named.
+        let e = read_uri("Cargo.toml", None, 10).unwrap_err();
+        assert!(e.contains("'Cargo.toml' is an external file"), "{e}");
+        let data = read_uri("data:application/octet-stream;base64,AAEC", None, 3).unwrap();
+        assert_eq!(data, vec![0, 1, 2]);
     }
 
     #[test]

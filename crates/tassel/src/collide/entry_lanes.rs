@@ -16,7 +16,9 @@
 //! arguments' trip through memory cost one character about 2 %.
 
 use super::lanes::{entry_radius_lanes, LaneContact};
-use crate::lanes::{closest_point_on_segment, Isa, Lane, Mask, F, LANES, M, V3};
+#[cfg(target_arch = "x86_64")]
+use crate::lanes::Isa;
+use crate::lanes::{closest_point_on_segment, Lane, Mask, F, LANES, M, V3};
 
 /// One `f64` per lane.
 #[derive(Clone, Copy)]

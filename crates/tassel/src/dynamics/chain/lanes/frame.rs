@@ -485,6 +485,9 @@ impl Ctx<'_> {
             Isa::Avx2 => return unsafe { self.model_pose_avx2(locals, s, count) },
             Isa::Portable => {}
         }
+        // (Only the x86-64 lane types need the choice.)
+        #[cfg(not(target_arch = "x86_64"))]
+        let _ = self.isa;
         self.model_pose_in::<F>(locals, s, count)
     }
 

@@ -55,6 +55,9 @@ impl Ctx<'_> {
             Isa::Avx2 => return unsafe { self.run_avx2(pack, scratch, base, input) },
             Isa::Portable => {}
         }
+        // (Only the x86-64 lane types need the choice.)
+        #[cfg(not(target_arch = "x86_64"))]
+        let _ = self.isa;
         self.gather::<F, I>(pack, scratch, base, input)?;
         self.step_baseline(pack, scratch);
         Ok(())

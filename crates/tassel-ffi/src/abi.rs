@@ -1,0 +1,454 @@
+//! The C ABI over [`FlatCharacter`]: the functions of `include/tassel.h`.
+//!
+//! Every function catches panics (none crosses the boundary: a panic is reported as an
+//! error) and takes NULL pointers, wrong lengths, misaligned or overlapping buffers and
+//! invalid UTF-8 as errors: `-1` (or NULL, or 0 where noted) and a message for
+//! [`tassel_last_error`]. A failed call changes nothing.
+//!
+//! What the caller promises (the `# Safety` of each function): a non-NULL pointer points
+//! to what the header says, valid for the length given, for the time of the call; a
+//! character pointer came from a load and was not freed; a character is used by one
+//! thread at a time.
+#![allow(unsafe_code)]
+
+use crate::flat::{FlatCharacter, FLOATS_PER_JOINT};
+use std::cell::RefCell;
+use std::ffi::{c_char, CStr, CString};
+use std::panic::{catch_unwind, AssertUnwindSafe};
+
+/// A loaded character (opaque): free it with `tassel_character_free`.
+pub struct TasselCharacter {
+    flat: FlatCharacter,
+    /// The joints' names as C strings (borrowed by `tassel_joint_name`).
+    names: Vec<CString>,
+    mode: CString,
+}
+
+thread_local! {
+    static LAST_ERROR: RefCell<Option<CString>> = const { RefCell::new(None) };
+}
+
+fn set_error(message: &str) {
+    let c = CString::new(message.replace('\0', " ")).unwrap_or_default();
+    LAST_ERROR.with(|e| *e.borrow_mut() = Some(c));
+}
+
+/// Runs `f`; an error or a panic sets this thread's last error and gives `failed`.
+fn guard<T>(function: &str, failed: T, f: impl FnOnce() -> Result<T, String>) -> T {
+    match catch_unwind(AssertUnwindSafe(f)) {
+        Ok(Ok(v)) => v,
+        Ok(Err(message)) => {
+            set_error(&format!("{function}: {message}"));
+            failed
+        }
+        Err(panic) => {
+            let what = panic
+                .downcast_ref::<&str>()
+                .map(|s| s.to_string())
+                .or_else(|| panic.downcast_ref::<String>().cloned())
+                .unwrap_or_default();
+            set_error(&format!(
+                "{function}: internal error (a panic, caught; please report it): {what}"
+            ));
+            failed
+        }
+    }
+}
+
+/// The character behind `c`, or an error for NULL.
+///
+/// # Safety
+/// `c` is NULL or a live character from a load.
+unsafe fn character<'a>(c: *const TasselCharacter) -> Result<&'a TasselCharacter, String> {
+    // SAFETY: the caller's promise: NULL or a live character.
+    unsafe { c.as_ref() }.ok_or_else(|| "the character is NULL".to_string())
+}
+
+/// # Safety
+/// `c` is NULL or a live character from a load, used by this thread alone.
+unsafe fn character_mut<'a>(c: *mut TasselCharacter) -> Result<&'a mut TasselCharacter, String> {
+    // SAFETY: the caller's promise: NULL or a live character, not shared during the call.
+    unsafe { c.as_mut() }.ok_or_else(|| "the character is NULL".to_string())
+}
+
+/// An optional UTF-8 C string.
+///
+/// # Safety
+/// `s` is NULL or a NUL-terminated string.
+unsafe fn opt_str<'a>(s: *const c_char, what: &str) -> Result<Option<&'a str>, String> {
+    if s.is_null() {
+        return Ok(None);
+    }
+    // SAFETY: the caller's promise: a NUL-terminated string.
+    let c = unsafe { CStr::from_ptr(s) };
+    c.to_str()
+        .map(Some)
+        .map_err(|e| format!("{what} is not UTF-8: {e}"))
+}
+
+/// A float buffer of `len` floats, checked for NULL and alignment.
+///
+/// # Safety
+/// `p` is NULL or points to `len` floats.
+unsafe fn floats<'a>(p: *const f32, len: usize, what: &str) -> Result<&'a [f32], String> {
+    check_ptr(p, len, what)?;
+    // SAFETY: non-NULL, aligned, and `len` floats by the caller's promise.
+    Ok(unsafe { std::slice::from_raw_parts(p, len) })
+}
+
+/// # Safety
+/// `p` is NULL or points to `len` floats no other live reference reads or writes.
+unsafe fn floats_mut<'a>(p: *mut f32, len: usize, what: &str) -> Result<&'a mut [f32], String> {
+    check_ptr(p, len, what)?;
+    // SAFETY: non-NULL, aligned, and `len` floats by the caller's promise.
+    Ok(unsafe { std::slice::from_raw_parts_mut(p, len) })
+}
+
+fn check_ptr(p: *const f32, len: usize, what: &str) -> Result<(), String> {
+    if p.is_null() {
+        return Err(format!("{what} is NULL"));
+    }
+    if !(p as usize).is_multiple_of(std::mem::align_of::<f32>()) {
+        return Err(format!("{what} is not aligned to 4 bytes"));
+    }
+    if len > isize::MAX as usize / std::mem::size_of::<f32>() {
+        return Err(format!("{what}: {len} floats is not a length"));
+    }
+    Ok(())
+}
+
+fn new_character(flat: FlatCharacter) -> *mut TasselCharacter {
+    let names = (0..flat.joint_count())
+        .map(|j| {
+            let name = flat.joint_name(j).unwrap_or_default().replace('\0', " ");
+            CString::new(name).unwrap_or_default()
+        })
+        .collect();
+    let mode = CString::new(flat.mode()).unwrap_or_default();
+    Box::into_raw(Box::new(TasselCharacter { flat, names, mode }))
+}
+
+/// Loads a character from the bytes of a GLB, VRM or glTF file (a `.gltf` whose buffers
+/// are external files is an error naming the URI; data: URIs work; see
+/// `tassel_character_load_file`). `rig_toml` (may be NULL) is a rig file's text: chains,
+/// springs, cloths, ropes; without it the file's VRM spring bones run (a file without
+/// them is an error). `mode` (may be NULL) is "fixed", "spec", "three-vrm" or "classic";
+/// NULL as `tassel simulate` without `--mode`: "fixed", unless the rig sets its chains to
+/// "classic".
+///
+/// The character is left as `tassel simulate` has it before its frame 1 (a zero-length
+/// frame at the rest pose, at the origin). NULL on error: `tassel_last_error()` says why.
+///
+/// # Safety
+/// `bytes` points to `len` bytes; `rig_toml` and `mode` are NULL or NUL-terminated.
+#[no_mangle]
+pub unsafe extern "C" fn tassel_character_load(
+    bytes: *const u8,
+    len: usize,
+    rig_toml: *const c_char,
+    mode: *const c_char,
+) -> *mut TasselCharacter {
+    guard("tassel_character_load", std::ptr::null_mut(), || {
+        if bytes.is_null() {
+            return Err("bytes is NULL".into());
+        }
+        // SAFETY: non-NULL; `len` bytes by the caller's promise.
+        let data = unsafe { std::slice::from_raw_parts(bytes, len) };
+        // SAFETY: NULL or NUL-terminated, by the caller's promise.
+        let (rig, mode) = unsafe { (opt_str(rig_toml, "rig_toml")?, opt_str(mode, "mode")?) };
+        Ok(new_character(FlatCharacter::load(data, rig, mode)?))
+    })
+}
+
+/// As `tassel_character_load`, from a file's path (UTF-8): a `.gltf` may read its
+/// buffers beside it.
+///
+/// # Safety
+/// `path` is a NUL-terminated string; `rig_toml` and `mode` are NULL or NUL-terminated.
+#[no_mangle]
+pub unsafe extern "C" fn tassel_character_load_file(
+    path: *const c_char,
+    rig_toml: *const c_char,
+    mode: *const c_char,
+) -> *mut TasselCharacter {
+    guard("tassel_character_load_file", std::ptr::null_mut(), || {
+        // SAFETY: NULL or NUL-terminated, by the caller's promise.
+        let (path, rig, mode) = unsafe {
+            (
+                opt_str(path, "path")?.ok_or("path is NULL")?,
+                opt_str(rig_toml, "rig_toml")?,
+                opt_str(mode, "mode")?,
+            )
+        };
+        Ok(new_character(FlatCharacter::load_file(
+            std::path::Path::new(path),
+            rig,
+            mode,
+        )?))
+    })
+}
+
+/// Frees a character (NULL: nothing happens).
+///
+/// # Safety
+/// `c` is NULL or a live character from a load, not used after this call.
+#[no_mangle]
+pub unsafe extern "C" fn tassel_character_free(c: *mut TasselCharacter) {
+    if !c.is_null() {
+        // SAFETY: a live character from `Box::into_raw`, given back once.
+        drop(unsafe { Box::from_raw(c) });
+    }
+}
+
+/// How many joints: every node of the file, in the file's node order. 0 for NULL.
+///
+/// # Safety
+/// `c` is NULL or a live character.
+#[no_mangle]
+pub unsafe extern "C" fn tassel_joint_count(c: *const TasselCharacter) -> usize {
+    // SAFETY: the caller's promise.
+    guard("tassel_joint_count", 0, || {
+        Ok(unsafe { character(c) }?.flat.joint_count())
+    })
+}
+
+/// Joint `joint`'s name, UTF-8, borrowed: valid while the character lives. NULL for
+/// NULL or a joint that does not exist.
+///
+/// # Safety
+/// `c` is NULL or a live character.
+#[no_mangle]
+pub unsafe extern "C" fn tassel_joint_name(
+    c: *const TasselCharacter,
+    joint: usize,
+) -> *const c_char {
+    guard("tassel_joint_name", std::ptr::null(), || {
+        // SAFETY: the caller's promise.
+        let ch = unsafe { character(c) }?;
+        ch.names
+            .get(joint)
+            .map(|n| n.as_ptr())
+            .ok_or_else(|| no_joint(ch, joint))
+    })
+}
+
+fn no_joint(ch: &TasselCharacter, joint: usize) -> String {
+    format!(
+        "joint {joint} does not exist (the character has {})",
+        ch.flat.joint_count()
+    )
+}
+
+/// Joint `joint`'s parent joint; -1 for a root; -2 for NULL or a joint that does not
+/// exist.
+///
+/// # Safety
+/// `c` is NULL or a live character.
+#[no_mangle]
+pub unsafe extern "C" fn tassel_joint_parent(c: *const TasselCharacter, joint: usize) -> i32 {
+    guard("tassel_joint_parent", -2, || {
+        // SAFETY: the caller's promise.
+        let ch = unsafe { character(c) }?;
+        if joint >= ch.flat.joint_count() {
+            return Err(no_joint(ch, joint));
+        }
+        Ok(ch.flat.joint_parent(joint).map_or(-1, |p| p as i32))
+    })
+}
+
+/// The rest pose (the file's node transforms) into `out`: 10 floats a joint (tx ty tz
+/// qx qy qz qw sx sy sz), `len` floats in all. 0 = ok, -1 = error.
+///
+/// # Safety
+/// `c` is NULL or a live character; `out` is NULL or points to `len` floats.
+#[no_mangle]
+pub unsafe extern "C" fn tassel_rest_locals(
+    c: *const TasselCharacter,
+    out: *mut f32,
+    len: usize,
+) -> i32 {
+    guard("tassel_rest_locals", -1, || {
+        // SAFETY: the caller's promises.
+        let (ch, out) = unsafe { (character(c)?, floats_mut(out, len, "out")?) };
+        ch.flat.rest_locals(out).map(|_| 0)
+    })
+}
+
+/// One frame. `root`: the character's world transform (10 floats); `locals_in`: the
+/// animated local transforms, 10 floats a joint in joint order; `locals_out`: the same,
+/// with the simulated joints written (every joint: the others copied from `locals_in`);
+/// it may be the same buffer as `locals_in` (not otherwise overlapping). `len`: the floats
+/// in each (10 a joint). `dt`: seconds since the last frame, ≥ 0 (0 is a valid frame).
+/// 0 = ok; -1 = error (NULL, a wrong length, NaN, a rotation that is not a unit
+/// quaternion, a negative `dt`): the character and `locals_out` are unchanged.
+///
+/// # Safety
+/// `c` is NULL or a live character; `root` is NULL or 10 floats; `locals_in` and
+/// `locals_out` are NULL or `len` floats each.
+#[no_mangle]
+pub unsafe extern "C" fn tassel_frame(
+    c: *mut TasselCharacter,
+    root: *const f32,
+    locals_in: *const f32,
+    locals_out: *mut f32,
+    len: usize,
+    dt: f32,
+) -> i32 {
+    guard("tassel_frame", -1, || {
+        // SAFETY: the caller's promises; the two buffers are made one slice when they are
+        // the same and refused when they overlap otherwise, so no two references alias.
+        unsafe {
+            let ch = character_mut(c)?;
+            let root = floats(root, FLOATS_PER_JOINT, "root")?;
+            if std::ptr::eq(locals_in, locals_out) {
+                let locals = floats_mut(locals_out, len, "locals_out")?;
+                ch.flat.frame(root, locals, dt)?;
+            } else {
+                let input = floats(locals_in, len, "locals_in")?;
+                check_ptr(locals_out, len, "locals_out")?;
+                let (a, b) = (locals_in as usize, locals_out as usize);
+                let bytes = len * std::mem::size_of::<f32>();
+                if a < b + bytes && b < a + bytes {
+                    return Err("locals_in and locals_out overlap without being the same \
+                                buffer"
+                        .into());
+                }
+                let output = floats_mut(locals_out, len, "locals_out")?;
+                ch.flat.frame_into(root, input, output, dt)?;
+            }
+        }
+        Ok(0)
+    })
+}
+
+/// Every solver starts again from the animated pose on the next frame, whatever its
+/// `dt` (NULL: nothing happens, an error is set).
+///
+/// # Safety
+/// `c` is NULL or a live character.
+#[no_mangle]
+pub unsafe extern "C" fn tassel_reset(c: *mut TasselCharacter) {
+    guard("tassel_reset", (), || {
+        // SAFETY: the caller's promise.
+        unsafe { character_mut(c) }?.flat.reset();
+        Ok(())
+    })
+}
+
+/// The character was moved on purpose (a respawn, a cut): the next frame starts again
+/// from the pose at the new place instead of whipping across the world (as
+/// `tassel_reset`).
+///
+/// # Safety
+/// `c` is NULL or a live character.
+#[no_mangle]
+pub unsafe extern "C" fn tassel_teleport(c: *mut TasselCharacter) {
+    guard("tassel_teleport", (), || {
+        // SAFETY: the caller's promise.
+        unsafe { character_mut(c) }?.flat.teleport();
+        Ok(())
+    })
+}
+
+/// How many joints a solver writes (the others' output is their input). 0 for NULL.
+///
+/// # Safety
+/// `c` is NULL or a live character.
+#[no_mangle]
+pub unsafe extern "C" fn tassel_simulated_joint_count(c: *const TasselCharacter) -> usize {
+    guard("tassel_simulated_joint_count", 0, || {
+        // SAFETY: the caller's promise.
+        Ok(unsafe { character(c) }?.flat.simulated_joints().len())
+    })
+}
+
+/// The joints a solver writes, ascending, into `out` (`len` entries: exactly
+/// `tassel_simulated_joint_count`). 0 = ok, -1 = error.
+///
+/// # Safety
+/// `c` is NULL or a live character; `out` is NULL or points to `len` entries.
+#[no_mangle]
+pub unsafe extern "C" fn tassel_simulated_joints(
+    c: *const TasselCharacter,
+    out: *mut usize,
+    len: usize,
+) -> i32 {
+    guard("tassel_simulated_joints", -1, || {
+        // SAFETY: the caller's promise.
+        let ch = unsafe { character(c) }?;
+        let joints = ch.flat.simulated_joints();
+        if out.is_null() {
+            return Err("out is NULL".into());
+        }
+        if len != joints.len() {
+            return Err(format!(
+                "out holds {len} entries; the character simulates {} joints",
+                joints.len()
+            ));
+        }
+        if !(out as usize).is_multiple_of(std::mem::align_of::<usize>()) {
+            return Err("out is not aligned".into());
+        }
+        // SAFETY: non-NULL, aligned, `len` entries by the caller's promise.
+        unsafe { std::slice::from_raw_parts_mut(out, len) }.copy_from_slice(joints);
+        Ok(0)
+    })
+}
+
+/// The mode the character steps in ("fixed", "spec", "three-vrm" or "classic"),
+/// borrowed: valid while the character lives. NULL for NULL.
+///
+/// # Safety
+/// `c` is NULL or a live character.
+#[no_mangle]
+pub unsafe extern "C" fn tassel_mode(c: *const TasselCharacter) -> *const c_char {
+    guard("tassel_mode", std::ptr::null(), || {
+        // SAFETY: the caller's promise.
+        Ok(unsafe { character(c) }?.mode.as_ptr())
+    })
+}
+
+/// The message of this thread's last failed call (UTF-8, borrowed until this thread's
+/// next failed call), or NULL if none failed.
+#[no_mangle]
+pub extern "C" fn tassel_last_error() -> *const c_char {
+    LAST_ERROR.with(|e| e.borrow().as_ref().map_or(std::ptr::null(), |c| c.as_ptr()))
+}
+
+/// The library's version ("0.1.0"), static.
+#[no_mangle]
+pub extern "C" fn tassel_version() -> *const c_char {
+    const VERSION: &CStr =
+        match CStr::from_bytes_with_nul(concat!(env!("CARGO_PKG_VERSION"), "\0").as_bytes()) {
+            Ok(v) => v,
+            Err(_) => panic!("the version has no NUL inside"),
+        };
+    VERSION.as_ptr()
+}
+
+/// `size` bytes of the library's memory, 16-byte aligned (NULL if `size` is 0 or too
+/// large): for hosts that cannot hand the library their own memory, such as JavaScript
+/// with the WebAssembly module. Free with `tassel_free(p, size)`.
+#[no_mangle]
+pub extern "C" fn tassel_alloc(size: usize) -> *mut u8 {
+    match std::alloc::Layout::from_size_align(size, 16) {
+        // SAFETY: the layout's size is not zero.
+        Ok(layout) if size > 0 => unsafe { std::alloc::alloc_zeroed(layout) },
+        _ => std::ptr::null_mut(),
+    }
+}
+
+/// Frees what `tassel_alloc(size)` gave (NULL: nothing happens).
+///
+/// # Safety
+/// `p` is NULL or came from `tassel_alloc` with the same `size`, and is not used after.
+#[no_mangle]
+pub unsafe extern "C" fn tassel_free(p: *mut u8, size: usize) {
+    if p.is_null() {
+        return;
+    }
+    if let Ok(layout) = std::alloc::Layout::from_size_align(size, 16) {
+        // SAFETY: allocated by `tassel_alloc` with this layout, by the caller's promise.
+        unsafe { std::alloc::dealloc(p, layout) }
+    }
+}

@@ -1,0 +1,298 @@
+//! The flat frame API: one character loaded from glTF/GLB/VRM bytes, stepped one frame at
+//! a time over plain `f32` buffers. No glam or Tassel type crosses it, so the C ABI
+//! ([`crate::abi`]) and the WebAssembly module are thin shells over this one type.
+
+use std::path::Path;
+use tassel::dynamics::vrm::VrmSpringBones;
+use tassel::dynamics::{RigSettings, SimMode};
+use tassel::glam::{Quat, Vec3};
+use tassel::{CharacterSim, Skeleton, Transform};
+
+/// Floats per joint transform: translation x y z, rotation quaternion x y z w, scale
+/// x y z.
+pub const FLOATS_PER_JOINT: usize = 10;
+
+/// The largest rig file taken (16 MiB, as `tassel simulate`).
+pub const MAX_RIG_BYTES: usize = 16 << 20;
+
+/// One character behind the flat API: its solvers ([`CharacterSim`]), and its joints in
+/// the file's node order (every node of the file is a joint, numbered as `tassel
+/// simulate` numbers nodes).
+///
+/// ```
+/// use tassel_ffi::{FlatCharacter, FLOATS_PER_JOINT};
+///
+/// // The built-in character as a GLB and its rig as TOML (a real file works the same:
+/// // its bytes, and its rig file's text).
+/// let c = tassel::builtin::character();
+/// let source = tassel_gltf::ExportSource::from_skeleton(&c.skeleton, tassel_gltf::BoneMesh::None);
+/// let glb = tassel_gltf::export_glb(&source, &[]).map_err(|e| e.to_string())?;
+/// let rig = c.rig.to_toml_string().map_err(|e| e.to_string())?;
+/// let mut character = FlatCharacter::load(&glb, Some(&rig), None)?;
+/// let n = character.joint_count();
+/// let mut locals = vec![0.0; n * FLOATS_PER_JOINT];
+/// character.rest_locals(&mut locals)?;
+/// let root = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0];
+/// // The animated pose in, the simulated one out (here in place).
+/// character.frame(&root, &mut locals, 1.0 / 60.0)?;
+/// assert!(locals.iter().all(|v| v.is_finite()));
+/// # Ok::<(), String>(())
+/// ```
+#[derive(Debug, Clone)]
+pub struct FlatCharacter {
+    sim: CharacterSim,
+    mode: SimMode,
+    /// Joint (skeleton order) of each node.
+    node_to_joint: Vec<usize>,
+    /// Node of each joint.
+    joint_to_node: Vec<usize>,
+    /// The nodes a solver writes, ascending.
+    written: Vec<usize>,
+    /// The animated pose of the frame being read, skeleton order (no allocation per
+    /// frame).
+    animated: Vec<Transform>,
+}
+
+/// `"fixed"`, `"spec"`, `"three-vrm"` or `"classic"` (as `tassel simulate --mode`).
+pub fn parse_mode(name: &str) -> Result<SimMode, String> {
+    [
+        SimMode::Fixed,
+        SimMode::Spec,
+        SimMode::ThreeVrm,
+        SimMode::Classic,
+    ]
+    .into_iter()
+    .find(|m| m.name() == name)
+    .ok_or_else(|| {
+        format!("mode '{name}' is not one of fixed, spec, three-vrm, classic (as tassel simulate --mode)")
+    })
+}
+
+impl FlatCharacter {
+    /// A character from the bytes of a GLB, VRM or glTF file (a `.gltf` whose buffers are
+    /// external files is an error naming the URI: memory reads no files; see
+    /// [`load_file`](Self::load_file)), an optional rig file's text (chains, springs,
+    /// cloths, ropes; optional for a VRM, whose spring bones run in any case) and an
+    /// optional mode (see [`parse_mode`]; `None`: as `tassel simulate` without `--mode`,
+    /// `fixed` unless the rig sets its chains to `classic`).
+    ///
+    /// The character is left as `tassel simulate` has it before its frame 1: a
+    /// zero-length frame at the rest pose, the character at the origin.
+    pub fn load(bytes: &[u8], rig_toml: Option<&str>, mode: Option<&str>) -> Result<Self, String> {
+        if bytes.is_empty() {
+            return Err("the file's bytes are empty".into());
+        }
+        let model = tassel_gltf::load_slice(bytes, None, "the file").map_err(|e| e.to_string())?;
+        Self::from_model(model, rig_toml, mode)
+    }
+
+    /// As [`load`](Self::load), from a file: a `.gltf` may read its buffers beside it.
+    pub fn load_file(
+        path: &Path,
+        rig_toml: Option<&str>,
+        mode: Option<&str>,
+    ) -> Result<Self, String> {
+        let model = tassel_gltf::load(path).map_err(|e| e.to_string())?;
+        Self::from_model(model, rig_toml, mode)
+    }
+
+    fn from_model(
+        model: tassel_gltf::Model,
+        rig_toml: Option<&str>,
+        mode: Option<&str>,
+    ) -> Result<Self, String> {
+        let vrm: VrmSpringBones = model.vrm.map(|v| v.springs).unwrap_or_default();
+        let mut rig = match rig_toml {
+            Some(text) if text.len() > MAX_RIG_BYTES => {
+                return Err(format!(
+                    "the rig file is larger than the limit of {MAX_RIG_BYTES} bytes"
+                ))
+            }
+            Some(text) => RigSettings::from_toml_str(text).map_err(|e| format!("rig: {e}"))?,
+            None if !vrm.is_empty() => RigSettings::default(),
+            None => {
+                return Err("the file has no VRM spring bones; give a rig file (TOML) \
+                            with its chains, springs, cloths or ropes"
+                    .into())
+            }
+        };
+        let requested = mode.map(parse_mode).transpose()?;
+        let (mode, options) = SimMode::apply(requested, &mut rig, !vrm.is_empty())
+            .map_err(|e| format!("mode: {e}"))?;
+        let skeleton: Skeleton = model.skeleton;
+        let rest = skeleton.rest().to_vec();
+        let mut sim =
+            CharacterSim::with_vrm(skeleton, &rig, &vrm, options).map_err(|e| e.to_string())?;
+        // The state before `tassel simulate`'s frame 1.
+        sim.frame(&rest, Transform::IDENTITY, 0.0)
+            .map_err(|e| e.to_string())?;
+        let joint_to_node = model.joint_to_node;
+        let mut written: Vec<usize> = sim
+            .simulated_joints()
+            .iter()
+            .map(|&j| joint_to_node[j])
+            .collect();
+        written.sort_unstable();
+        Ok(Self {
+            sim,
+            mode,
+            node_to_joint: model.node_to_joint,
+            joint_to_node,
+            written,
+            animated: rest,
+        })
+    }
+
+    /// How many joints (the file's nodes).
+    pub fn joint_count(&self) -> usize {
+        self.node_to_joint.len()
+    }
+
+    /// Node `joint`'s name (a node without one is called `node<i>`; a repeated name gets
+    /// `#<i>`, as everywhere in Tassel).
+    pub fn joint_name(&self, joint: usize) -> Option<&str> {
+        let j = *self.node_to_joint.get(joint)?;
+        Some(self.sim.skeleton().name(j))
+    }
+
+    /// Node `joint`'s parent node (`None`: a root of the scene, or no such joint).
+    pub fn joint_parent(&self, joint: usize) -> Option<usize> {
+        let j = *self.node_to_joint.get(joint)?;
+        self.sim.skeleton().parent(j).map(|p| self.joint_to_node[p])
+    }
+
+    /// The joints a solver writes (node indices, ascending): every other joint's output is
+    /// its input.
+    pub fn simulated_joints(&self) -> &[usize] {
+        &self.written
+    }
+
+    /// The mode the character steps in.
+    pub fn mode(&self) -> &'static str {
+        self.mode.name()
+    }
+
+    /// The rest pose (the file's node transforms): [`FLOATS_PER_JOINT`] floats a joint.
+    pub fn rest_locals(&self, out: &mut [f32]) -> Result<(), String> {
+        self.check_len("out", out.len())?;
+        let rest = self.sim.skeleton().rest();
+        for (node, chunk) in out.chunks_exact_mut(FLOATS_PER_JOINT).enumerate() {
+            write(&rest[self.node_to_joint[node]], chunk);
+        }
+        Ok(())
+    }
+
+    /// One frame in place: `root` is the character's world transform (10 floats),
+    /// `locals` the animated local transforms of every joint in joint order on the way in
+    /// and the simulated ones on the way out (only the simulated joints are written), `dt`
+    /// the time since the last frame in seconds (0 is a valid frame: nothing moves in
+    /// time). On an error (wrong lengths, NaN, a rotation that is not a unit quaternion,
+    /// a negative `dt`) nothing changes, in the buffer or in the character.
+    pub fn frame(&mut self, root: &[f32], locals: &mut [f32], dt: f32) -> Result<(), String> {
+        self.step(root, locals, dt)?;
+        self.write_simulated(locals);
+        Ok(())
+    }
+
+    /// One frame from `locals_in` into `locals_out` (every joint: the animated ones as
+    /// they came in); otherwise as [`frame`](Self::frame). On an error `locals_out` is
+    /// left as it was.
+    pub fn frame_into(
+        &mut self,
+        root: &[f32],
+        locals_in: &[f32],
+        locals_out: &mut [f32],
+        dt: f32,
+    ) -> Result<(), String> {
+        self.check_len("locals_out", locals_out.len())?;
+        self.step(root, locals_in, dt)?;
+        locals_out.copy_from_slice(locals_in);
+        self.write_simulated(locals_out);
+        Ok(())
+    }
+
+    /// Every solver starts again from the animated pose on the next frame (whatever that
+    /// frame's `dt`).
+    pub fn reset(&mut self) {
+        self.sim.reset();
+    }
+
+    /// The character was moved on purpose (a respawn, a cut): the next frame starts again
+    /// from the pose at the new place instead of whipping the hair across the world (as
+    /// [`reset`](Self::reset)).
+    pub fn teleport(&mut self) {
+        self.sim.reset();
+    }
+
+    /// The solvers, for Rust callers who want more than the flat API (chain tips, VRM
+    /// tails, the output in model space).
+    pub fn sim(&self) -> &CharacterSim {
+        &self.sim
+    }
+
+    /// The node of skeleton joint `joint` (the order of [`Self::sim`]'s poses).
+    pub fn node_of(&self, joint: usize) -> Option<usize> {
+        self.joint_to_node.get(joint).copied()
+    }
+
+    fn check_len(&self, what: &str, len: usize) -> Result<(), String> {
+        let want = self.joint_count() * FLOATS_PER_JOINT;
+        if len == want {
+            Ok(())
+        } else {
+            Err(format!(
+                "{what} holds {len} floats; the character has {} joints, {want} floats \
+                 ({FLOATS_PER_JOINT} a joint)",
+                self.joint_count()
+            ))
+        }
+    }
+
+    fn step(&mut self, root: &[f32], locals: &[f32], dt: f32) -> Result<(), String> {
+        if root.len() != FLOATS_PER_JOINT {
+            return Err(format!(
+                "root holds {} floats, not {FLOATS_PER_JOINT} (tx ty tz qx qy qz qw sx sy sz)",
+                root.len()
+            ));
+        }
+        self.check_len("locals", locals.len())?;
+        for (node, chunk) in locals.chunks_exact(FLOATS_PER_JOINT).enumerate() {
+            self.animated[self.node_to_joint[node]] = read(chunk);
+        }
+        // The simulation checks every input before it touches its state.
+        self.sim
+            .frame(&self.animated, read(root), dt)
+            .map_err(|e| match e {
+                tassel::Error::NonFinite(what) => {
+                    format!("non-finite value in {what}").replace("joint '", "joint (node) '")
+                }
+                e => e.to_string(),
+            })?;
+        Ok(())
+    }
+
+    fn write_simulated(&self, out: &mut [f32]) {
+        let locals = &self.sim.pose().locals;
+        for &node in &self.written {
+            let at = node * FLOATS_PER_JOINT;
+            write(
+                &locals[self.node_to_joint[node]],
+                &mut out[at..at + FLOATS_PER_JOINT],
+            );
+        }
+    }
+}
+
+fn read(v: &[f32]) -> Transform {
+    Transform::new(
+        Vec3::new(v[0], v[1], v[2]),
+        Quat::from_xyzw(v[3], v[4], v[5], v[6]),
+        Vec3::new(v[7], v[8], v[9]),
+    )
+}
+
+fn write(t: &Transform, out: &mut [f32]) {
+    out[..3].copy_from_slice(&t.translation.to_array());
+    out[3..7].copy_from_slice(&t.rotation.to_array());
+    out[7..10].copy_from_slice(&t.scale.to_array());
+}

@@ -1,0 +1,127 @@
+"""A Python client of Tassel's C ABI through ctypes, run by tests/c_abi.rs.
+
+    python3 frame.py LIBRARY FILE MODE FRAMES DT AMP FREQ
+
+As tests/c/frame.c: loads FILE's bytes (its VRM spring bones), moves the root along x by
+AMP * sin(2 pi FREQ t), feeds the rest pose every frame and prints each joint's world
+position per frame ("P frame joint x y z"), composed here in Python from the output
+locals. Errors (a bad mode, a wrong length, NaN) must come back as values with a message.
+"""
+import ctypes
+import ctypes.util
+import math
+import sys
+
+lib_path, path, mode, frames, dt, amp, freq = sys.argv[1:8]
+frames, dt, amp, freq = int(frames), float(dt), float(amp), float(freq)
+lib = ctypes.CDLL(lib_path)
+
+P = ctypes.c_void_p
+FLOATS = ctypes.POINTER(ctypes.c_float)
+lib.tassel_character_load.restype = P
+lib.tassel_character_load.argtypes = [ctypes.c_char_p, ctypes.c_size_t, ctypes.c_char_p, ctypes.c_char_p]
+lib.tassel_character_free.argtypes = [P]
+lib.tassel_joint_count.restype = ctypes.c_size_t
+lib.tassel_joint_count.argtypes = [P]
+lib.tassel_joint_parent.restype = ctypes.c_int32
+lib.tassel_joint_parent.argtypes = [P, ctypes.c_size_t]
+lib.tassel_joint_name.restype = ctypes.c_char_p
+lib.tassel_joint_name.argtypes = [P, ctypes.c_size_t]
+lib.tassel_rest_locals.restype = ctypes.c_int32
+lib.tassel_rest_locals.argtypes = [P, FLOATS, ctypes.c_size_t]
+lib.tassel_frame.restype = ctypes.c_int32
+lib.tassel_frame.argtypes = [P, FLOATS, FLOATS, FLOATS, ctypes.c_size_t, ctypes.c_float]
+lib.tassel_last_error.restype = ctypes.c_char_p
+
+failures = 0
+
+
+def fail(what):
+    global failures
+    print("FAIL", what, "(last error:", lib.tassel_last_error(), ")")
+    failures += 1
+
+
+data = open(path, "rb").read()
+if lib.tassel_character_load(data, len(data), None, b"sideways"):
+    fail("mode 'sideways' loaded")
+elif b"sideways" not in (lib.tassel_last_error() or b""):
+    fail("the bad mode is not named")
+c = lib.tassel_character_load(data, len(data), None, mode.encode())
+if not c:
+    fail("load")
+    sys.exit(1)
+n = lib.tassel_joint_count(c)
+parents = [lib.tassel_joint_parent(c, j) for j in range(n)]
+Floats = ctypes.c_float * (10 * n)
+rest, out = Floats(), Floats()
+if lib.tassel_rest_locals(c, rest, 10 * n) != 0:
+    fail("rest_locals")
+bad = Floats(*rest)
+bad[3] = float("nan")
+root = (ctypes.c_float * 10)()
+if lib.tassel_frame(c, root, bad, out, 10 * n, ctypes.c_float(dt)) != -1:
+    fail("a NaN frame passed")
+if lib.tassel_frame(c, root, rest, out, 10 * n - 1, ctypes.c_float(dt)) != -1:
+    fail("a short frame passed")
+print("J", n)
+
+
+def qmul(p, q):
+    return (
+        p[3] * q[0] + p[0] * q[3] + p[1] * q[2] - p[2] * q[1],
+        p[3] * q[1] - p[0] * q[2] + p[1] * q[3] + p[2] * q[0],
+        p[3] * q[2] + p[0] * q[1] - p[1] * q[0] + p[2] * q[3],
+        p[3] * q[3] - p[0] * q[0] - p[1] * q[1] - p[2] * q[2],
+    )
+
+
+def rotate(q, v):
+    u, w = q[:3], q[3]
+    c1 = (u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0])
+    c2 = (u[1] * c1[2] - u[2] * c1[1], u[2] * c1[0] - u[0] * c1[2], u[0] * c1[1] - u[1] * c1[0])
+    return tuple(v[i] + 2 * (w * c1[i] + c2[i]) for i in range(3))
+
+
+def compose(a, b):
+    t = rotate(a[1], tuple(a[2][i] * b[0][i] for i in range(3)))
+    return (
+        tuple(a[0][i] + t[i] for i in range(3)),
+        qmul(a[1], b[1]),
+        tuple(a[2][i] * b[2][i] for i in range(3)),
+    )
+
+
+def f32(v):
+    """`v` rounded to a 32-bit float: the root moves as tassel simulate computes it."""
+    return ctypes.c_float(v).value
+
+
+# The C library's sinf, as Rust's f32::sin calls it on Linux.
+libm = ctypes.CDLL(ctypes.util.find_library("m"))
+libm.sinf.restype = ctypes.c_float
+libm.sinf.argtypes = [ctypes.c_float]
+TAU = f32(2 * math.pi)
+for f in range(1, frames + 1):
+    t = f32(f * f32(dt))
+    w = f32(f32(TAU * f32(freq)) * t)
+    x = f32(f32(amp) * libm.sinf(w))
+    root = (ctypes.c_float * 10)(x, 0, 0, 0, 0, 0, 1, 1, 1, 1)
+    if lib.tassel_frame(c, root, rest, out, 10 * n, ctypes.c_float(dt)) != 0:
+        fail("frame %d" % f)
+    r = (tuple(root[0:3]), tuple(root[3:7]), tuple(root[7:10]))
+    world = [None] * n
+
+    def world_of(j):
+        if world[j] is None:
+            local = (tuple(out[10 * j:10 * j + 3]), tuple(out[10 * j + 3:10 * j + 7]), tuple(out[10 * j + 7:10 * j + 10]))
+            parent = r if parents[j] < 0 else world_of(parents[j])
+            world[j] = compose(parent, local)
+        return world[j]
+
+    for j in range(n):
+        p = world_of(j)[0]
+        print("P %d %d %.9g %.9g %.9g" % (f, j, p[0], p[1], p[2]))
+lib.tassel_character_free(c)
+print("DONE", failures)
+sys.exit(1 if failures else 0)

@@ -1,0 +1,48 @@
+// Types of tassel-three (web/src/index.js).
+import type { Object3D } from 'three';
+
+/** What GLTFLoader gives (`gltf.scene` and `gltf.parser.associations` are used). */
+export interface GLTFLike {
+  scene: Object3D;
+  parser: { associations: Map<unknown, { nodes?: number }> };
+}
+
+export type TasselMode = 'fixed' | 'spec' | 'three-vrm' | 'classic';
+
+export interface TasselOptions {
+  /** fixed (default), spec, three-vrm or classic. */
+  mode?: TasselMode;
+  /** Where the .wasm is (URL), its bytes, or a compiled module; default: beside index.js. */
+  wasm?: string | URL | ArrayBuffer | Uint8Array | WebAssembly.Module;
+  /** Called with the message when an update fails (default: console.warn once). */
+  onError?: (message: string) => void;
+}
+
+/** Loads the WebAssembly module once (done by fromGLTF too). */
+export function loadTassel(source?: string | URL | ArrayBuffer | Uint8Array | WebAssembly.Module): Promise<unknown>;
+
+/** A drop-in for three-vrm's VRMSpringBoneManager, stepped by Tassel. */
+export class TasselSpringBoneManager {
+  static fromGLTF(gltf: GLTFLike, bytes: ArrayBuffer | Uint8Array, options?: TasselOptions & { rigToml?: string }): Promise<TasselSpringBoneManager>;
+  readonly mode: TasselMode;
+  readonly bones: Object3D[];
+  readonly lastError: string | null;
+  update(delta: number): boolean;
+  reset(): void;
+  setInitState(): void;
+  teleport(): void;
+  dispose(): void;
+}
+
+/** Any skinned glTF with a Tassel rig file, stepped by Tassel. */
+export class TasselCharacter {
+  static fromGLTF(gltf: GLTFLike, bytes: ArrayBuffer | Uint8Array, rigToml: string | null, options?: TasselOptions): Promise<TasselCharacter>;
+  readonly mode: TasselMode;
+  readonly bones: Object3D[];
+  readonly lastError: string | null;
+  update(delta: number): boolean;
+  reset(): void;
+  setInitState(): void;
+  teleport(): void;
+  dispose(): void;
+}
