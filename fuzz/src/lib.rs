@@ -61,6 +61,67 @@ pub fn gltf_import(data: &[u8]) {
     }
 }
 
+/// glTF/GLB/VRM bytes → the C ABI's `tassel_character_load` (as a C, Python or
+/// WebAssembly caller uses it: bytes from memory, no rig, `fixed` and `spec`); a character
+/// that loads is stepped through `tassel_frame` on a swaying root: every call returns 0 or
+/// -1 with a message, every output float is finite, NULL and wrong lengths are refused.
+/// The same corpus as [`gltf_import`].
+#[allow(unsafe_code)]
+pub fn ffi_load(data: &[u8]) {
+    use std::ffi::CStr;
+    use tassel_ffi::abi::*;
+    for mode in [c"fixed", c"spec"] {
+        // SAFETY: `data` is `data.len()` bytes; the mode is NUL-terminated.
+        let c = unsafe {
+            tassel_character_load(data.as_ptr(), data.len(), std::ptr::null(), mode.as_ptr())
+        };
+        if c.is_null() {
+            let e = tassel_last_error();
+            assert!(!e.is_null(), "ffi_load: a failed load left no message");
+            // SAFETY: a NUL-terminated string of this thread, alive until its next error.
+            let message = unsafe { CStr::from_ptr(e) }.to_string_lossy();
+            assert!(!message.is_empty(), "ffi_load: an empty message");
+            continue;
+        }
+        // SAFETY: `c` is a live character; every buffer is as long as the length given.
+        unsafe {
+            let n = tassel_joint_count(c);
+            let mut locals = vec![0.0f32; n * 10];
+            assert_eq!(tassel_rest_locals(c, locals.as_mut_ptr(), locals.len()), 0);
+            let mut out = vec![0.0f32; n * 10];
+            for f in 0..4 {
+                let x = 0.3 * (f as f32 * 0.7).sin();
+                let root = [x, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0];
+                let ok = tassel_frame(
+                    c,
+                    root.as_ptr(),
+                    locals.as_ptr(),
+                    out.as_mut_ptr(),
+                    out.len(),
+                    1.0 / 30.0,
+                );
+                if ok == 0 {
+                    assert!(
+                        out.iter().all(|v| v.is_finite()),
+                        "ffi_load: a non-finite output"
+                    );
+                }
+                let short = tassel_frame(
+                    c,
+                    root.as_ptr(),
+                    locals.as_ptr(),
+                    out.as_mut_ptr(),
+                    out.len().saturating_sub(1),
+                    1.0 / 30.0,
+                );
+                assert_eq!(short, -1, "ffi_load: a short buffer was taken");
+            }
+            assert!(tassel_joint_name(c, n).is_null());
+            tassel_character_free(c);
+        }
+    }
+}
+
 /// Rig TOML text → `RigSettings::from_toml_str`; a rig that parses is compiled on the
 /// built-in character and run for a few frames of its walk.
 pub fn rig_toml(data: &[u8]) {

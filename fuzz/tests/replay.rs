@@ -64,6 +64,18 @@ fn gltf_import_replays() {
     );
 }
 
+/// The C ABI's load on the glTF importer's inputs (its regressions and the test files).
+#[test]
+fn ffi_load_replays() {
+    let mut seeds = files(&root().join("regressions").join("gltf_import"));
+    if let Some(dir) = testdata() {
+        seeds.extend(files(&dir.join("gltf")));
+        seeds.extend(files(&dir.join("vrm")));
+    }
+    let n = replay("ffi_load", tassel_fuzz::ffi_load, &seeds);
+    assert!(n >= 8, "only {n} inputs");
+}
+
 #[test]
 fn rig_toml_replays() {
     let seeds = files(&root().join("../examples/rigs"));

@@ -51,8 +51,12 @@ export async function runBench({ counts = [1, 100], frames = 200, runs = 7, log 
     for (const k of kinds) sets[k] = await characters(k, n, ctx);
     const steps = Math.max(20, Math.round(frames / Math.sqrt(n)));
     const times = Object.fromEntries(kinds.map((k) => [k, []]));
-    // Warm up (JIT, caches), then interleaved runs.
-    for (const k of kinds) run(sets[k], 30, 1 / 60, 0);
+    // Warm up for a second each: the JavaScript JIT and WebAssembly's tier-up (V8 starts
+    // a module in its baseline compiler, Liftoff, and optimises hot functions later).
+    for (const k of kinds) {
+      const until = performance.now() + 1000;
+      while (performance.now() < until) run(sets[k], 10, 1 / 60, 0);
+    }
     for (let r = 0; r < runs; r++) {
       for (const k of kinds) {
         const ms = run(sets[k], steps, 1 / 60, (r + 1) * 10);

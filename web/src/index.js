@@ -127,6 +127,7 @@ class Driver {
     this.ptr = ptr;
     this.scene = gltf.scene;
     this.onError = options.onError ?? null;
+    this.syncRotation = options.syncRotation ?? false;
     this.lastError = null;
     this.mode = tassel.string(x.tassel_mode(ptr));
     const n = x.tassel_joint_count(ptr);
@@ -239,15 +240,15 @@ class Driver {
     }
     this.lastError = null;
     const out = this.locals();
-    for (const j of this.written) {
-      const o = this.objects[j];
+    const written = this.written;
+    const objects = this.objects;
+    const syncRotation = this.syncRotation;
+    for (let w = 0; w < written.length; w++) {
+      const j = written[w];
+      const o = objects[j];
       const at = j * FLOATS;
-      writeObject(o, out, at);
       for (let k = 0; k < FLOATS; k++) wrote[at + k] = out[at + k];
-      o.updateMatrix();
-      const p = o.parent;
-      if (p) o.matrixWorld.multiplyMatrices(p.matrixWorld, o.matrix);
-      else o.matrixWorld.copy(o.matrix);
+      setLocal(o, out, at, syncRotation);
     }
     this.hasWritten = true;
     return true;
@@ -267,6 +268,50 @@ function readObject(o, out, at) {
   out[at] = p.x; out[at + 1] = p.y; out[at + 2] = p.z;
   out[at + 3] = q.x; out[at + 4] = q.y; out[at + 5] = q.z; out[at + 6] = q.w;
   out[at + 7] = s.x; out[at + 8] = s.y; out[at + 9] = s.z;
+}
+
+/** Writes bone `o`'s local transform from `v[at..at + 10]` and refreshes its `matrix` and
+ *  `matrixWorld` (from its parent's), as three-vrm leaves its spring bones. The quaternion
+ *  is written through its fields: three.js's setter would also recompute the Euler
+ *  `rotation`, which costs more than the whole spring step; `syncRotation` asks for it. */
+function setLocal(o, v, at, syncRotation) {
+  const tx = v[at], ty = v[at + 1], tz = v[at + 2];
+  const x = v[at + 3], y = v[at + 4], z = v[at + 5], w = v[at + 6];
+  const sx = v[at + 7], sy = v[at + 8], sz = v[at + 9];
+  const p = o.position, q = o.quaternion, s = o.scale;
+  p.x = tx; p.y = ty; p.z = tz;
+  q._x = x; q._y = y; q._z = z; q._w = w;
+  s.x = sx; s.y = sy; s.z = sz;
+  if (syncRotation) o.rotation.setFromQuaternion(q, undefined, false);
+  // As Matrix4.compose.
+  const m = o.matrix.elements;
+  const x2 = x + x, y2 = y + y, z2 = z + z;
+  const xx = x * x2, xy = x * y2, xz = x * z2;
+  const yy = y * y2, yz = y * z2, zz = z * z2;
+  const wx = w * x2, wy = w * y2, wz = w * z2;
+  m[0] = (1 - (yy + zz)) * sx; m[1] = (xy + wz) * sx; m[2] = (xz - wy) * sx; m[3] = 0;
+  m[4] = (xy - wz) * sy; m[5] = (1 - (xx + zz)) * sy; m[6] = (yz + wx) * sy; m[7] = 0;
+  m[8] = (xz + wy) * sz; m[9] = (yz - wx) * sz; m[10] = (1 - (xx + yy)) * sz; m[11] = 0;
+  m[12] = tx; m[13] = ty; m[14] = tz; m[15] = 1;
+  const parent = o.parent;
+  const r = o.matrixWorld.elements;
+  if (parent === null) {
+    for (let i = 0; i < 16; i++) r[i] = m[i];
+    return;
+  }
+  // As Matrix4.multiplyMatrices(parent.matrixWorld, matrix), the last row (0 0 0 1).
+  const a = parent.matrixWorld.elements;
+  const a11 = a[0], a12 = a[4], a13 = a[8], a14 = a[12];
+  const a21 = a[1], a22 = a[5], a23 = a[9], a24 = a[13];
+  const a31 = a[2], a32 = a[6], a33 = a[10], a34 = a[14];
+  const a41 = a[3], a42 = a[7], a43 = a[11], a44 = a[15];
+  for (let c = 0; c < 16; c += 4) {
+    const b1 = m[c], b2 = m[c + 1], b3 = m[c + 2], b4 = m[c + 3];
+    r[c] = a11 * b1 + a12 * b2 + a13 * b3 + a14 * b4;
+    r[c + 1] = a21 * b1 + a22 * b2 + a23 * b3 + a24 * b4;
+    r[c + 2] = a31 * b1 + a32 * b2 + a33 * b3 + a34 * b4;
+    r[c + 3] = a41 * b1 + a42 * b2 + a43 * b3 + a44 * b4;
+  }
 }
 
 function writeObject(o, v, at) {

@@ -242,3 +242,55 @@ fn a_python_program_matches_tassel_simulate() {
         assert!(d <= 1e-6, "{} {mode}: {d} m", file.display());
     }
 }
+
+/// The C example of README.md (its one ```c block, a function `swing(bytes, len)`)
+/// compiles without a warning and runs on a test VRM: every frame steps.
+#[test]
+fn the_readme_c_example_runs() {
+    let files = vrm_files();
+    if files.is_empty() {
+        return;
+    }
+    let readme = std::fs::read_to_string(manifest().join("../../README.md")).unwrap();
+    let start = readme.find("```c\n").expect("README.md has a ```c block") + 5;
+    let end = start + readme[start..].find("```").unwrap();
+    let example = &readme[start..end];
+    assert!(
+        example.lines().count() <= 25,
+        "the README's C example is long"
+    );
+    let tmp = PathBuf::from(env!("CARGO_TARGET_TMPDIR"));
+    let source = tmp.join("readme_example.c");
+    std::fs::write(
+        &source,
+        format!(
+            "{example}\n#include <string.h>\nint main(int argc, char **argv) {{\n  \
+             FILE *f = fopen(argv[1], \"rb\");\n  static uint8_t buf[1 << 24];\n  \
+             size_t len = fread(buf, 1, sizeof buf, f);\n  fclose(f);\n  \
+             return swing(buf, len) == 0 && tassel_last_error() == NULL ? 0 : 1;\n}}\n"
+        ),
+    )
+    .unwrap();
+    let exe = tmp.join("readme_example");
+    let cc = std::env::var("CC").unwrap_or_else(|_| "cc".into());
+    run(
+        Command::new(&cc)
+            .args(["-std=c11", "-Wall", "-Wextra", "-Werror", "-I"])
+            .arg(manifest().join("include"))
+            .arg(&source)
+            .arg(library("libtassel_ffi.a"))
+            .args([
+                "-lgcc_s",
+                "-lutil",
+                "-lrt",
+                "-lpthread",
+                "-lm",
+                "-ldl",
+                "-lc",
+            ])
+            .arg("-o")
+            .arg(&exe),
+        "compiling README.md's C example",
+    );
+    run(Command::new(&exe).arg(&files[0]), "README.md's C example");
+}

@@ -1,0 +1,28 @@
+// `node bench/browser.mjs [FRAMES] [RUNS]`: bench/index.html in headless Chromium (Debian's
+// /usr/bin/chromium): three-vrm's spring update against Tassel's, side by side in the page.
+import { chromium } from 'playwright-core';
+import { start } from '../test/serve.mjs';
+
+const frames = Number(process.argv[2] ?? 400);
+const runs = Number(process.argv[3] ?? 7);
+const server = await start(0);
+const browser = await chromium.launch({
+  executablePath: process.env.CHROMIUM ?? '/usr/bin/chromium',
+  args: ['--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
+    '--disable-background-networking', '--disable-component-update', '--disable-sync'],
+});
+try {
+  const page = await browser.newPage();
+  page.on('console', (m) => console.log(m.text()));
+  page.on('pageerror', (e) => console.log(`page error: ${e.message}`));
+  await page.goto(`http://127.0.0.1:${server.address().port}/bench/?frames=${frames}&runs=${runs}`);
+  await page.waitForFunction(() => window.tasselBench !== undefined, null, { timeout: 900_000 });
+  const { rows, userAgent } = await page.evaluate(() => window.tasselBench);
+  console.log(userAgent);
+  for (const r of rows) {
+    console.log(`${r.characters} x ${r.joints} joints: three-vrm ${r['three-vrm 3.5.5'].toFixed(1)} ns/joint, Tassel three-vrm mode ${r['Tassel three-vrm'].toFixed(1)} (${r.speedup_three_vrm_mode.toFixed(1)}x), Tassel fixed ${r['Tassel fixed'].toFixed(1)} (${r.speedup_fixed.toFixed(1)}x)`);
+  }
+} finally {
+  await browser.close();
+  server.close();
+}
