@@ -4,6 +4,7 @@
 //   /modules/    web/node_modules/  (three, three-vrm; the pages' import map points here)
 //   /testdata/   ../shared/testdata/
 //   /oracles/    ../shared/oracles/ (the spec hook; no node_modules)
+//   /demo/       web/dist/demo/     (demo.glb and demo.rig.toml by `tassel demo --out web/dist/demo`)
 //   /testdata.json  the VRM files of ../shared/testdata/vrm
 // `node test/serve.mjs [PORT]` serves until stopped; `start(port)` is the module's API.
 import fs from 'node:fs';
@@ -17,6 +18,7 @@ const roots = [
   ['/modules/', path.join(web, 'node_modules')],
   ['/testdata/', path.join(shared, 'testdata')],
   ['/oracles/', path.join(shared, 'oracles')],
+  ['/demo/', path.join(web, 'dist/demo')],
   ['/', web],
 ];
 const types = {

@@ -401,8 +401,13 @@ pub fn run(a: Args) -> Result<(), String> {
         .map_err(|e| e.to_string())?;
     let glb_path = a.out.join("demo.glb");
     let png_path = a.out.join("demo.png");
+    // The built-in character's rig beside its file: what a tool outside Rust (the C ABI,
+    // tassel-three's demo page) loads with demo.glb.
+    let rig_path = a.out.join("demo.rig.toml");
+    let rig_text = c.rig.to_toml_string().map_err(|e| e.to_string())?;
     write_atomic(&glb_path, &glb)?;
     write_atomic(&png_path, &png)?;
+    write_atomic(&rig_path, rig_text.as_bytes())?;
     let simulated = sim.chains().point_count() - sim.chains().chain_count()
         + sim.cloths().simulated_joints().count()
         + sim.ropes().simulated_joints().count();
@@ -441,11 +446,12 @@ pub fn run(a: Args) -> Result<(), String> {
     );
     say!("  states: {} ({events} events)", visited.join(" > "));
     say!(
-        "  wrote {} ({} bytes) and {} ({} bytes)",
+        "  wrote {} ({} bytes), {} ({} bytes) and its rig, {}",
         glb_path.display(),
         glb.len(),
         png_path.display(),
-        png.len()
+        png.len(),
+        rig_path.display()
     );
     Ok(())
 }

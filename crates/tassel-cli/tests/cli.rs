@@ -45,6 +45,12 @@ fn demo_writes_valid_files_and_is_deterministic() {
         std::fs::read(b.join("demo.png")).unwrap()
     );
     assert_eq!(&std::fs::read(a.join("demo.png")).unwrap()[1..4], b"PNG");
+    // The rig written beside demo.glb reads back as the built-in character's own.
+    let rig = std::fs::read_to_string(a.join("demo.rig.toml")).unwrap();
+    assert_eq!(
+        tassel::dynamics::RigSettings::from_toml_str(&rig).unwrap(),
+        tassel::builtin::character().rig
+    );
     if let Some(report) = validate(&a.join("demo.glb")) {
         assert!(report.contains("\"errors\":0"), "{report}");
     }
