@@ -26,6 +26,27 @@ pub struct Band {
 }
 
 /// A chart to draw.
+///
+/// ```
+/// use tassel_render::{Chart, ChartSeries, PALETTE};
+///
+/// let points = (0..=100).map(|i| i as f32 * 0.01).map(|t| (t, (6.28 * t).sin())).collect();
+/// let chart = Chart {
+///     title: "A SWING".into(),
+///     x_label: "TIME (S)".into(),
+///     y_label: "ANGLE (RAD)".into(),
+///     series: vec![ChartSeries { name: "tip".into(), color: PALETTE[0], points }],
+///     ..Chart::default()
+/// };
+/// let canvas = chart.draw(640, 360);
+/// assert_eq!((canvas.width(), canvas.height()), (640, 360));
+/// // The line is drawn in its colour.
+/// let drawn = canvas.pixels().chunks(3).filter(|p| *p == PALETTE[0]).count();
+/// assert!(drawn > 100, "{drawn} pixels of the line");
+/// let png = canvas.png()?;
+/// assert_eq!(&png[1..4], b"PNG");
+/// # Ok::<(), tassel_render::RenderError>(())
+/// ```
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Chart {
     /// Title over the plot.
