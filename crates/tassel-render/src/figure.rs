@@ -63,6 +63,23 @@ pub struct Bone {
 }
 
 /// One moment of a character, world space.
+///
+/// ```
+/// use tassel::{builtin, CharacterSim, Transform};
+/// use tassel_render::{contact_sheet, Figure, SIMULATED_COLOR};
+///
+/// let c = builtin::character();
+/// let mut sim = CharacterSim::new(c.skeleton.clone(), &c.rig).unwrap();
+/// sim.frame(c.skeleton.rest(), Transform::IDENTITY, 0.0).unwrap();
+/// let figure = Figure::from_sim(&sim, &Transform::IDENTITY, 0.0);
+/// // A bone to every joint that has a parent (and to the chains' virtual tips).
+/// let parented = (0..c.skeleton.len()).filter(|&j| c.skeleton.parent(j).is_some()).count();
+/// assert!(figure.bones.len() >= parented);
+/// assert!(figure.bones.iter().any(|b| b.simulated));
+/// // Side and front views; the simulated bones in their colour.
+/// let sheet = contact_sheet(&[figure], "AT REST");
+/// assert!(sheet.pixels().chunks(3).any(|p| p == SIMULATED_COLOR));
+/// ```
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Figure {
     /// Bones.
