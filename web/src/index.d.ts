@@ -16,16 +16,19 @@ export interface TasselOptions {
   wasm?: string | URL | ArrayBuffer | Uint8Array | WebAssembly.Module;
   /** Called with the message when an update fails (default: console.warn once). */
   onError?: (message: string) => void;
+  /** Also keep the written bones' Euler `rotation` in step (costs more than the step). */
+  syncRotation?: boolean;
 }
 
 /** Loads the WebAssembly module once (done by fromGLTF too). */
 export function loadTassel(source?: string | URL | ArrayBuffer | Uint8Array | WebAssembly.Module): Promise<unknown>;
 
-/** A drop-in for three-vrm's VRMSpringBoneManager, stepped by Tassel. */
-export class TasselSpringBoneManager {
-  static fromGLTF(gltf: GLTFLike, bytes: ArrayBuffer | Uint8Array, options?: TasselOptions & { rigToml?: string }): Promise<TasselSpringBoneManager>;
+/** What both classes share: one character stepped by Tassel. */
+declare class Stepped {
   readonly mode: TasselMode;
+  /** The three.js objects Tassel writes. */
   readonly bones: Object3D[];
+  /** The last update's error (null when it stepped). */
   readonly lastError: string | null;
   update(delta: number): boolean;
   reset(): void;
@@ -34,15 +37,12 @@ export class TasselSpringBoneManager {
   dispose(): void;
 }
 
+/** A drop-in for three-vrm's VRMSpringBoneManager, stepped by Tassel. */
+export class TasselSpringBoneManager extends Stepped {
+  static fromGLTF(gltf: GLTFLike, bytes: ArrayBuffer | Uint8Array, options?: TasselOptions & { rigToml?: string }): Promise<TasselSpringBoneManager>;
+}
+
 /** Any skinned glTF with a Tassel rig file, stepped by Tassel. */
-export class TasselCharacter {
+export class TasselCharacter extends Stepped {
   static fromGLTF(gltf: GLTFLike, bytes: ArrayBuffer | Uint8Array, rigToml: string | null, options?: TasselOptions): Promise<TasselCharacter>;
-  readonly mode: TasselMode;
-  readonly bones: Object3D[];
-  readonly lastError: string | null;
-  update(delta: number): boolean;
-  reset(): void;
-  setInitState(): void;
-  teleport(): void;
-  dispose(): void;
 }

@@ -201,8 +201,7 @@ class Driver {
     const a = this.animated;
     for (const j of this.written) {
       const o = this.objects[j];
-      writeObject(o, a, j * FLOATS);
-      o.updateMatrix();
+      setLocal(o, a, j * FLOATS, this.syncRotation);
     }
     this.hasWritten = false;
     this.tassel.x.tassel_reset(this.ptr);
@@ -314,12 +313,6 @@ function setLocal(o, v, at, syncRotation) {
   }
 }
 
-function writeObject(o, v, at) {
-  o.position.set(v[at], v[at + 1], v[at + 2]);
-  o.quaternion.set(v[at + 3], v[at + 4], v[at + 5], v[at + 6]);
-  o.scale.set(v[at + 7], v[at + 8], v[at + 9]);
-}
-
 /** Whether `o` still holds what was written (as float32: what the module gave). */
 function holds(o, v, at) {
   const p = o.position, q = o.quaternion, s = o.scale;
@@ -361,37 +354,27 @@ function decompose(m, out) {
   out[7] = sx; out[8] = sy; out[9] = sz;
 }
 
-/** A drop-in for three-vrm's VRMSpringBoneManager, stepped by Tassel: the file's VRM
- *  spring bones (VRMC_springBone 1.0 or VRM 0.x secondaryAnimation) in `fixed` (the same
- *  look at every frame rate; default), `spec` (the specification's update) or `three-vrm`
- *  mode (three-vrm 3.5.5's own results). */
-export class TasselSpringBoneManager {
-  /** `gltf`: the GLTFLoader result (with or without three-vrm's plugins); `bytes`: the same
-   *  file's ArrayBuffer or Uint8Array. */
-  static async fromGLTF(gltf, bytes, options = {}) {
-    const tassel = await loadTassel(options.wasm);
-    const ptr = tassel.load(bytes, options.rigToml ?? null, options.mode ?? 'fixed');
-    return new TasselSpringBoneManager(new Driver(tassel, ptr, gltf, options));
-  }
-
+/** What both public classes are: one character stepped by Tassel. */
+class Stepped {
   constructor(driver) {
     this._driver = driver;
   }
 
   /** `fixed`, `spec`, `three-vrm` or `classic`. */
   get mode() { return this._driver.mode; }
-  /** The three.js objects Tassel writes (the spring bones). */
+  /** The three.js objects Tassel writes (the simulated bones). */
   get bones() { return Array.from(this._driver.written, (j) => this._driver.objects[j]); }
   /** The last update's error (null when it stepped). */
   get lastError() { return this._driver.lastError; }
 
-  /** One frame of `delta` seconds: reads the bones' current local transforms and the
-   *  scene's world transform, writes the spring bones' local transforms (and refreshes
-   *  their matrices). Returns false (the bones untouched) on bad input, such as NaN. */
+  /** One frame of `delta` seconds (after the AnimationMixer's, if any): reads the bones'
+   *  current local transforms and the scene's world transform, writes the simulated bones'
+   *  local transforms (and refreshes their matrices). Returns false (the bones untouched)
+   *  on bad input, such as NaN. */
   update(delta) { return this._driver.update(delta); }
-  /** The spring bones go back to their initial pose and start again from it. */
+  /** The simulated bones go back to their animated (initial) pose and start again from it. */
   reset() { this._driver.reset(); }
-  /** The bones' current pose becomes the initial pose the springs start from. */
+  /** The bones' current pose becomes the pose the simulation starts from. */
   setInitState() { this._driver.setInitState(); }
   /** The character was moved on purpose: start again at the new place, no whip. */
   teleport() { this._driver.teleport(); }
@@ -399,26 +382,26 @@ export class TasselSpringBoneManager {
   dispose() { this._driver.dispose(); }
 }
 
+/** A drop-in for three-vrm's VRMSpringBoneManager, stepped by Tassel: the file's VRM
+ *  spring bones (VRMC_springBone 1.0 or VRM 0.x secondaryAnimation) in `fixed` (the same
+ *  look at every frame rate; default), `spec` (the specification's update) or `three-vrm`
+ *  mode (three-vrm 3.5.5's own results). */
+export class TasselSpringBoneManager extends Stepped {
+  /** `gltf`: the GLTFLoader result (with or without three-vrm's plugins); `bytes`: the same
+   *  file's ArrayBuffer or Uint8Array. */
+  static async fromGLTF(gltf, bytes, options = {}) {
+    const tassel = await loadTassel(options.wasm);
+    const ptr = tassel.load(bytes, options.rigToml ?? null, options.mode ?? 'fixed');
+    return new TasselSpringBoneManager(new Driver(tassel, ptr, gltf, options));
+  }
+}
+
 /** Any skinned glTF with a Tassel rig file (chains, springs, cloths, ropes; VRM springs
  *  too), stepped by Tassel. */
-export class TasselCharacter {
+export class TasselCharacter extends Stepped {
   static async fromGLTF(gltf, bytes, rigToml, options = {}) {
     const tassel = await loadTassel(options.wasm);
     const ptr = tassel.load(bytes, rigToml ?? null, options.mode ?? null);
     return new TasselCharacter(new Driver(tassel, ptr, gltf, options));
   }
-
-  constructor(driver) {
-    this._driver = driver;
-  }
-
-  get mode() { return this._driver.mode; }
-  get bones() { return Array.from(this._driver.written, (j) => this._driver.objects[j]); }
-  get lastError() { return this._driver.lastError; }
-  /** One frame, after the AnimationMixer's: see TasselSpringBoneManager.update. */
-  update(delta) { return this._driver.update(delta); }
-  reset() { this._driver.reset(); }
-  setInitState() { this._driver.setInitState(); }
-  teleport() { this._driver.teleport(); }
-  dispose() { this._driver.dispose(); }
 }

@@ -170,21 +170,17 @@ fn run(cmd: &mut Command, what: &str) -> Vec<u8> {
     out.stdout
 }
 
-#[test]
-fn a_c_program_matches_tassel_simulate() {
-    let files = vrm_files();
-    if files.is_empty() {
-        return;
-    }
-    let lib = library("libtassel_ffi.a");
-    let exe = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("tassel-ffi-frame");
+/// `source` compiled with the system's C compiler (`$CC`, else `cc`; warnings are errors)
+/// against `include/tassel.h` and the static library, into the test's scratch folder.
+fn compile_c(source: &Path, name: &str) -> PathBuf {
+    let exe = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(name);
     let cc = std::env::var("CC").unwrap_or_else(|_| "cc".into());
     run(
         Command::new(&cc)
             .args(["-std=c11", "-O1", "-Wall", "-Wextra", "-Werror", "-I"])
             .arg(manifest().join("include"))
-            .arg(manifest().join("tests/c/frame.c"))
-            .arg(&lib)
+            .arg(source)
+            .arg(library("libtassel_ffi.a"))
             // What Rust's standard library needs from the system (rustc's
             // --print native-static-libs on Linux).
             .args([
@@ -198,8 +194,18 @@ fn a_c_program_matches_tassel_simulate() {
             ])
             .arg("-o")
             .arg(&exe),
-        "compiling tests/c/frame.c",
+        &format!("compiling {}", source.display()),
     );
+    exe
+}
+
+#[test]
+fn a_c_program_matches_tassel_simulate() {
+    let files = vrm_files();
+    if files.is_empty() {
+        return;
+    }
+    let exe = compile_c(&manifest().join("tests/c/frame.c"), "tassel-ffi-frame");
     for file in &files {
         for mode in ["fixed", "spec"] {
             let out = run(
@@ -265,32 +271,12 @@ fn the_readme_c_example_runs() {
         &source,
         format!(
             "{example}\n#include <string.h>\nint main(int argc, char **argv) {{\n  \
-             FILE *f = fopen(argv[1], \"rb\");\n  static uint8_t buf[1 << 24];\n  \
+             (void)argc;\n  FILE *f = fopen(argv[1], \"rb\");\n  static uint8_t buf[1 << 24];\n  \
              size_t len = fread(buf, 1, sizeof buf, f);\n  fclose(f);\n  \
              return swing(buf, len) == 0 && tassel_last_error() == NULL ? 0 : 1;\n}}\n"
         ),
     )
     .unwrap();
-    let exe = tmp.join("readme_example");
-    let cc = std::env::var("CC").unwrap_or_else(|_| "cc".into());
-    run(
-        Command::new(&cc)
-            .args(["-std=c11", "-Wall", "-Wextra", "-Werror", "-I"])
-            .arg(manifest().join("include"))
-            .arg(&source)
-            .arg(library("libtassel_ffi.a"))
-            .args([
-                "-lgcc_s",
-                "-lutil",
-                "-lrt",
-                "-lpthread",
-                "-lm",
-                "-ldl",
-                "-lc",
-            ])
-            .arg("-o")
-            .arg(&exe),
-        "compiling README.md's C example",
-    );
+    let exe = compile_c(&source, "readme_example");
     run(Command::new(&exe).arg(&files[0]), "README.md's C example");
 }
