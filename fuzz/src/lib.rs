@@ -13,8 +13,8 @@ use std::path::Path;
 use std::sync::OnceLock;
 use tassel::anim::{Playback, SamplingCursor, SamplingJob, StateMachine};
 use tassel::dynamics::vrm::{
-    VrmCollider, VrmColliderGroup, VrmJoint, VrmMode, VrmOptions, VrmShape, VrmSpring,
-    VrmSpringBones, VrmTail,
+    VrmCollider, VrmColliderGroup, VrmJoint, VrmLimit, VrmLimitShape, VrmMode, VrmOptions,
+    VrmShape, VrmSpring, VrmSpringBones, VrmTail,
 };
 use tassel::dynamics::RigSettings;
 use tassel::{builtin, CharacterSim, Skeleton, SkeletonBuilder, Transform};
@@ -493,6 +493,7 @@ fn vrm_subject(u: &mut Unstructured) -> Option<(Skeleton, VrmSpringBones, VrmOpt
             VrmTail::Local(Vec3::new(0.0, -0.07, 0.0))
         };
         let extreme = u.ratio(1, 10).ok()?;
+        let limit_kind = u.int_in_range(0..=3u8).ok()?;
         let mut value = |scale: f32| {
             if extreme {
                 special(u)
@@ -508,6 +509,19 @@ fn vrm_subject(u: &mut Unstructured) -> Option<(Skeleton, VrmSpringBones, VrmOpt
             gravity_power: value(2.0),
             gravity_dir: Vec3::NEG_Y,
             drag_force: value(1.0),
+            // `VRMC_springBone_limit`: any shape, any angles (bad ones must be refused).
+            limit: match limit_kind {
+                0 => None,
+                1 => Some(VrmLimit::new(VrmLimitShape::Cone { angle: value(4.0) })),
+                2 => Some(VrmLimit::new(VrmLimitShape::Hinge { angle: value(4.0) })),
+                _ => Some(VrmLimit {
+                    shape: VrmLimitShape::Spherical {
+                        pitch: value(4.0),
+                        yaw: value(2.0),
+                    },
+                    rotation: Quat::from_xyzw(value(1.0), value(1.0), value(1.0), value(1.0)),
+                }),
+            },
         });
     }
     springs.springs.push(VrmSpring {

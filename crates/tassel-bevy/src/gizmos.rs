@@ -12,7 +12,7 @@ use tassel::collide::Shape;
 use tassel::dynamics::vrm::PlacedVrmCollider;
 
 /// Draws each character's colliders (orange), chain points and links (cyan) and VRM
-/// spring bones from joint to tail (magenta). Needs Bevy's gizmo plugin (in
+/// spring bones from joint to tail (magenta) with their swing limits (yellow). Needs Bevy's gizmo plugin (in
 /// `DefaultPlugins` with the `bevy_gizmos` feature).
 #[derive(Default)]
 pub struct TasselGizmosPlugin;
@@ -26,6 +26,7 @@ impl Plugin for TasselGizmosPlugin {
 const COLLIDER: Color = Color::srgb(1.0, 0.55, 0.1);
 const CHAIN: Color = Color::srgb(0.2, 0.9, 1.0);
 const SPRING: Color = Color::srgb(1.0, 0.3, 0.9);
+const LIMIT: Color = Color::srgb(1.0, 0.85, 0.2);
 
 fn draw(mut gizmos: Gizmos, characters: Query<&TasselCharacter>) {
     // Characters stepped in a crowd have no sim of their own to draw from
@@ -52,6 +53,14 @@ fn draw(mut gizmos: Gizmos, characters: Query<&TasselCharacter>) {
                 (sim.bone_world(link.joint), sim.vrm_tail_world(link.joint))
             {
                 gizmos.line(joint.translation, tail, SPRING);
+                // A limit (`VRMC_springBone_limit`): its boundary at the bone's length,
+                // and a few lines from the joint to it.
+                if let Some(rim) = sim.vrm_limit_outline(link.joint, 24) {
+                    for p in rim.iter().step_by(6) {
+                        gizmos.line(joint.translation, *p, LIMIT);
+                    }
+                    gizmos.linestrip(rim, LIMIT);
+                }
             }
         }
         for c in sim.vrm_state().placed_colliders() {

@@ -306,6 +306,117 @@ fn bake_vrm_keeps_its_extensions() {
     }
 }
 
+/// A GLB from a JSON and a BIN chunk (glTF 2.0 §4.4), padded as the container requires.
+fn glb_bytes(json: &Value, bin: &[u8]) -> Vec<u8> {
+    let mut j = serde_json::to_vec(json).unwrap();
+    while !j.len().is_multiple_of(4) {
+        j.push(b' ');
+    }
+    let mut b = bin.to_vec();
+    while !b.len().is_multiple_of(4) {
+        b.push(0);
+    }
+    let total = 12 + 8 + j.len() + 8 + b.len();
+    let mut out = Vec::with_capacity(total);
+    out.extend_from_slice(b"glTF");
+    out.extend_from_slice(&2u32.to_le_bytes());
+    out.extend_from_slice(&(total as u32).to_le_bytes());
+    out.extend_from_slice(&(j.len() as u32).to_le_bytes());
+    out.extend_from_slice(b"JSON");
+    out.extend_from_slice(&j);
+    out.extend_from_slice(&(b.len() as u32).to_le_bytes());
+    out.extend_from_slice(b"BIN\0");
+    out.extend_from_slice(&b);
+    out
+}
+
+/// `VRMC_springBone_limit`: a file whose first spring joint has a 3° cone keeps the
+/// extension through `bake`, and every baked key of that joint stays in the cone (the chain
+/// hangs along −Y, the draft's special case of the limit's frame), while the same sway
+/// without the limit swings it much further.
+#[test]
+fn bake_vrm_keeps_and_respects_spring_bone_limits() {
+    let Some(vrm) = testdata("vrm/smoke_spring.vrm") else {
+        return;
+    };
+    let dir = tmp("bake-vrm-limit");
+    let (mut json, bin) = glb_chunks(&std::fs::read(&vrm).unwrap());
+    let cone = 0.05f32;
+    let joint0 = &mut json["extensions"]["VRMC_springBone"]["springs"][0]["joints"][0];
+    joint0["extensions"] = serde_json::json!({
+        "VRMC_springBone_limit": {"specVersion": "1.0-draft", "limit": {"cone": {"angle": cone}}}
+    });
+    let node = joint0["node"].as_u64().unwrap();
+    json["extensionsUsed"]
+        .as_array_mut()
+        .unwrap()
+        .push("VRMC_springBone_limit".into());
+    let limited = dir.join("limited.vrm");
+    std::fs::write(&limited, glb_bytes(&json, &bin)).unwrap();
+    // The bone axis: the next joint's rest translation, in the joint's space.
+    let next = json["extensions"]["VRMC_springBone"]["springs"][0]["joints"][1]["node"]
+        .as_u64()
+        .unwrap();
+    let t: Vec<f32> = json["nodes"][next as usize]["translation"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap() as f32)
+        .collect();
+    let axis = glam::Vec3::new(t[0], t[1], t[2]).normalize();
+    assert!(json["nodes"][node as usize].get("rotation").is_none());
+    let largest_swing = |file: &Path, out: &Path| -> f32 {
+        let run = tassel()
+            .arg("bake")
+            .arg(file)
+            .args([
+                "--mode",
+                "fixed",
+                "--warmup",
+                "0",
+                "--sway",
+                "0.3,0,0.2",
+                "-o",
+            ])
+            .arg(out)
+            .output()
+            .unwrap();
+        assert!(
+            run.status.success(),
+            "{}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+        let (oj, ob) = glb_chunks(&std::fs::read(out).unwrap());
+        let (ij, _) = glb_chunks(&std::fs::read(file).unwrap());
+        assert_eq!(oj["extensions"], ij["extensions"], "extensions changed");
+        assert_eq!(oj["extensionsUsed"], ij["extensionsUsed"]);
+        let chans = channels(&oj, &ob, 0);
+        let (_, values) = &chans[&(node, "rotation".to_string())];
+        values
+            .chunks(4)
+            .map(|q| {
+                let q = glam::Quat::from_xyzw(q[0], q[1], q[2], q[3]).normalize();
+                // The rest rotation is the identity: the angle from the rest bone.
+                (q * axis).angle_between(axis)
+            })
+            .fold(0.0f32, f32::max)
+    };
+    let with = largest_swing(&limited, &dir.join("baked-limited.vrm"));
+    let without = largest_swing(&vrm, &dir.join("baked-free.vrm"));
+    assert!(
+        with <= cone + 1e-4,
+        "a baked key {with} rad from rest, past the {cone} rad cone"
+    );
+    assert!(
+        with > 0.8 * cone,
+        "the joint never reached its cone ({with} rad)"
+    );
+    assert!(
+        without > 3.0 * cone,
+        "without the limit it swings only {without} rad"
+    );
+}
+
 fn assert_bake_fails(args: &[&std::ffi::OsStr], out: &Path, needle: &str) {
     let run = tassel()
         .arg("bake")

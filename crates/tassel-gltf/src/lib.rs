@@ -2,7 +2,8 @@
 //!
 //! - [`load`] / [`load_slice`]: nodes (every node becomes a joint), skins with their
 //!   inverse bind matrices, the rest pose and animation clips, and VRM spring bones
-//!   (`VRMC_springBone` 1.0 with extended colliders, VRM 0.x `secondaryAnimation`).
+//!   (`VRMC_springBone` 1.0 with extended colliders and the `VRMC_springBone_limit` draft,
+//!   VRM 0.x `secondaryAnimation`).
 //! - [`export_glb`]: a GLB with the skeleton (and, when there was an input file, its
 //!   meshes, skins, materials and textures) plus baked animations, one key per frame;
 //!   baked keys can go into an input animation in place ([`BakedClip::merge_into`]);
@@ -41,6 +42,7 @@ mod scene;
 mod tessellate;
 mod uri;
 mod vrm;
+mod vrm_limit;
 
 pub use bake::{
     bake_clip, key_times, play, BakeOptions, BakeSource, PlayedFrame, Sway, MAX_BAKE_KEYS,

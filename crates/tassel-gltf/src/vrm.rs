@@ -329,7 +329,16 @@ fn read_v1(
                 gravity_power: number(j, "gravityPower", &jat, 0.0)?,
                 gravity_dir: vec3_array(j, "gravityDir", &jat, Vec3::NEG_Y)?,
                 drag_force: number(j, "dragForce", &jat, 0.5)?,
+                limit: crate::vrm_limit::read_limit(j, &jat, warnings)?,
             });
+        }
+        if read.last().is_some_and(|j| j.limit.is_some()) {
+            warnings.push(format!(
+                "{at}.joints[{}] has a {} but is the spring's last joint (only a tail, it \
+                 does not turn): the limit is ignored",
+                read.len() - 1,
+                crate::vrm_limit::EXTENSION
+            ));
         }
         if read.len() < 2 {
             warnings.push(format!(
@@ -496,6 +505,7 @@ fn read_v0(
             gravity_power: number(g, "gravityPower", &at, 0.0)?,
             gravity_dir: vec3_xyz(g, "gravityDir", &at, Vec3::NEG_Y)?,
             drag_force: number(g, "dragForce", &at, 0.4)?,
+            limit: None,
         };
         let mut joints = Vec::new();
         for (k, b) in array(g, "bones", &at)?.iter().enumerate() {

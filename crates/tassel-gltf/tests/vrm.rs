@@ -872,3 +872,102 @@ fn reset_is_a_fresh_start_on_every_file() {
         }
     }
 }
+
+/// `VRMC_springBone_limit` (draft 1.0): each joint's limit read as the file gives it (angles
+/// in radians, the rotation as x y z w), the last joint's (a tail only) ignored with a
+/// warning, bad limits named by their path in the file.
+#[test]
+fn spring_bone_limits_are_read_and_bad_ones_named() {
+    use tassel::dynamics::vrm::{VrmLimit, VrmLimitShape};
+    if testdata("vrm").is_none() {
+        return;
+    }
+    fn joints(j: &mut Value) -> &mut Value {
+        &mut j["extensions"]["VRMC_springBone"]["springs"][0]["joints"]
+    }
+    let with = |limits: Vec<(usize, Value)>| {
+        edited(move |j| {
+            j["extensionsUsed"] = serde_json::json!(["VRMC_springBone", "VRMC_springBone_limit"]);
+            for (k, limit) in limits {
+                joints(j)[k]["extensions"] = serde_json::json!({
+                    "VRMC_springBone_limit": {"specVersion": "1.0-draft", "limit": limit}
+                });
+            }
+        })
+    };
+    let h = std::f32::consts::FRAC_1_SQRT_2;
+    let model = with(vec![
+        (
+            0,
+            serde_json::json!({"cone": {"angle": 0.5, "rotation": [h, 0.0, 0.0, h]}}),
+        ),
+        (1, serde_json::json!({"hinge": {"angle": 1.25}})),
+        (
+            2,
+            serde_json::json!({"spherical": {"pitch": 0.75, "yaw": 0.25}}),
+        ),
+        (4, serde_json::json!({"cone": {"angle": 0.1}})),
+    ])
+    .unwrap();
+    let springs = &model.vrm.as_ref().unwrap().springs.springs[0];
+    // Joints 0..=3 turn (4 is the last tail).
+    let limit = |k: usize| springs.joints[k].limit;
+    assert_eq!(
+        limit(0),
+        Some(VrmLimit {
+            shape: VrmLimitShape::Cone { angle: 0.5 },
+            rotation: glam::Quat::from_xyzw(h, 0.0, 0.0, h),
+        })
+    );
+    assert_eq!(
+        limit(1),
+        Some(VrmLimit::new(VrmLimitShape::Hinge { angle: 1.25 }))
+    );
+    assert_eq!(
+        limit(2),
+        Some(VrmLimit::new(VrmLimitShape::Spherical {
+            pitch: 0.75,
+            yaw: 0.25
+        }))
+    );
+    assert_eq!(limit(3), None);
+    assert!(
+        model
+            .warnings
+            .iter()
+            .any(|w| w.contains("joints[4]") && w.contains("limit is ignored")),
+        "{:?}",
+        model.warnings
+    );
+    // Compiled for the skeleton: three limited links.
+    let rig = tassel::dynamics::vrm::VrmRig::new(
+        &model.skeleton,
+        &model.vrm.as_ref().unwrap().springs,
+        Default::default(),
+    )
+    .unwrap();
+    assert_eq!(rig.links.iter().filter(|l| l.limit.is_some()).count(), 3);
+    for (limit, says) in [
+        (
+            serde_json::json!({"cone": {"angle": -0.2}}),
+            "joints[1].extensions.VRMC_springBone_limit.limit.cone.angle is -0.2",
+        ),
+        (
+            serde_json::json!({"spherical": {"pitch": 0.2}}),
+            "limit.spherical.yaw is missing",
+        ),
+        (
+            serde_json::json!({"cone": {"angle": 0.2}, "hinge": {"angle": 0.2}}),
+            "has 2 (cone, hinge); the draft allows exactly one",
+        ),
+        (serde_json::json!({}), "has none of cone, hinge, spherical"),
+        (
+            serde_json::json!({"hinge": {"angle": 0.2, "rotation": [0, 0, 1]}}),
+            "limit.hinge.rotation must be 4 numbers",
+        ),
+    ] {
+        let e = with(vec![(1, limit)]).expect_err(says);
+        assert!(e.contains(says), "'{e}' does not say '{says}'");
+        assert!(e.contains("edited.gltf"), "{e}");
+    }
+}

@@ -62,6 +62,16 @@ pub struct Bone {
     pub simulated: bool,
 }
 
+/// A spring joint's swing limit (`VRMC_springBone_limit`): its boundary at the bone's
+/// length from the joint, world space.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct LimitOutline {
+    /// The joint the bone turns about.
+    pub joint: Vec3,
+    /// The boundary, walked around (the cone's rim, the hinge's arc, the spherical box).
+    pub rim: Vec<Vec3>,
+}
+
 /// One moment of a character, world space.
 ///
 /// ```
@@ -86,14 +96,17 @@ pub struct Figure {
     pub bones: Vec<Bone>,
     /// Colliders.
     pub colliders: Vec<Outline>,
+    /// Swing limits of VRM spring joints.
+    pub limits: Vec<LimitOutline>,
     /// Seconds into the clip (for labels).
     pub time: f32,
 }
 
 impl Figure {
     /// The last frame of `sim` under the character transform `component`: every bone
-    /// whose parent is a joint, chain tips without a joint, and the colliders of the VRM
-    /// springs, the chains (or, without chains, the cloths).
+    /// whose parent is a joint, chain tips without a joint, the colliders of the VRM
+    /// springs, the chains (or, without chains, the cloths), and the VRM springs' swing
+    /// limits.
     pub fn from_sim(sim: &CharacterSim, component: &Transform, time: f32) -> Figure {
         let sk = sim.skeleton();
         let models = &sim.pose().models;
@@ -152,9 +165,28 @@ impl Figure {
         } else {
             colliders.extend(sim.cloth_state().placed_colliders().iter().map(outline));
         }
+        let limits = sim
+            .vrm()
+            .links
+            .iter()
+            .filter_map(|l| {
+                let rim = sim.vrm_limit_outline(l.joint, 24)?;
+                // `vrm_limit_outline` is under the sim's own transform: re-placed here
+                // under `component`, as the bones are.
+                let to_here = *component * sim.component().inverse();
+                Some(LimitOutline {
+                    joint: world(models[l.joint].translation),
+                    rim: rim
+                        .into_iter()
+                        .map(|p| to_here.transform_point(p))
+                        .collect(),
+                })
+            })
+            .collect();
         Figure {
             bones,
             colliders,
+            limits,
             time,
         }
     }

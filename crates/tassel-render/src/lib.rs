@@ -15,11 +15,11 @@ mod strip;
 pub use canvas::{Canvas, Rgb};
 pub use chart::{ticks, Band, Chart, ChartSeries, PALETTE};
 pub use error::RenderError;
-pub use figure::{outline, Bone, Figure, Outline};
+pub use figure::{outline, Bone, Figure, LimitOutline, Outline};
 pub use gif::encode_gif;
 pub use sheet::{
     animation_frames, contact_sheet, draw_view, Framing, View, BONE_COLOR, COLLIDER_COLOR,
-    SIMULATED_COLOR,
+    LIMIT_COLOR, SIMULATED_COLOR,
 };
 pub use strip::{
     draw_strip, side_outlines, Panel, CHART_HEIGHT, MAX_SCALE, PANEL_WIDTH, TITLE_HEIGHT,

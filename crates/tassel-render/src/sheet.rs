@@ -12,6 +12,7 @@ const FRAME: Rgb = [215, 215, 210];
 const BONE: Rgb = [90, 90, 96];
 const SIMULATED: Rgb = [235, 110, 30];
 const COLLIDER: Rgb = [60, 160, 80];
+const LIMIT: Rgb = [200, 160, 20];
 const INK: Rgb = [40, 40, 40];
 
 /// A direction the skeleton is seen from.
@@ -112,6 +113,15 @@ pub fn draw_view(
     let to = framing.map(x, y, w, h);
     let s = framing.scale(w, h);
     let pt = |p: Vec3| to(view.project(p));
+    for l in &figure.limits {
+        // The boundary, and a few lines from the joint to it.
+        for w in l.rim.windows(2) {
+            canvas.line(pt(w[0]), pt(w[1]), 1.0, LIMIT);
+        }
+        for p in l.rim.iter().step_by(6) {
+            canvas.line(pt(l.joint), pt(*p), 1.0, LIMIT);
+        }
+    }
     for c in &figure.colliders {
         match *c {
             Outline::Sphere { center, radius } => {
@@ -289,6 +299,8 @@ pub const SIMULATED_COLOR: Rgb = SIMULATED;
 pub const BONE_COLOR: Rgb = BONE;
 /// The colour of colliders.
 pub const COLLIDER_COLOR: Rgb = COLLIDER;
+/// The colour of VRM swing limits.
+pub const LIMIT_COLOR: Rgb = LIMIT;
 
 #[cfg(test)]
 mod tests {
@@ -309,6 +321,7 @@ mod tests {
                 center: Vec3::new(0.0, 0.5, 0.0),
                 radius: 0.25,
             }],
+            limits: vec![],
             time: 0.0,
         };
         let framing = Framing::fit(std::slice::from_ref(&fig), View::Front);

@@ -340,6 +340,25 @@ impl CharacterSim {
             .tail_world(&self.rig.vrm, link, &self.component, &self.pose.models)
     }
 
+    /// The swing limit (`VRMC_springBone_limit`) of the VRM spring link on joint `joint`
+    /// as of the last frame, for drawing: `n` points of its boundary in world space at the
+    /// bone's length from the joint (the cone's rim, the hinge's arc, the spherical box's
+    /// outline), under the parent's current rotation. `None` when no limited spring link
+    /// moves the joint.
+    pub fn vrm_limit_outline(&self, joint: usize, n: usize) -> Option<Vec<Vec3>> {
+        let vrm = &self.rig.vrm;
+        let i = vrm.links.binary_search_by_key(&joint, |l| l.joint).ok()?;
+        let link = &vrm.links[i];
+        let limit = link.limit.as_ref()?;
+        let parent = match link.parent {
+            Some(p) => self.component * *self.pose.models.get(p)?,
+            None => self.component,
+        };
+        let position = self.bone_world(joint)?.translation;
+        let length = *self.vrm_state.lengths().get(i)?;
+        Some(limit.outline_world(parent.rotation, position, length, n))
+    }
+
     /// The last output pose.
     pub fn pose(&self) -> &Pose {
         &self.pose

@@ -266,6 +266,7 @@ fn degenerate_vrm(mode: VrmMode) -> (CharacterSim, Vec<usize>) {
             gravity_power: 0.3,
             gravity_dir: Vec3::NEG_Y,
             drag_force: 0.4,
+            limit: None,
         })
         .collect();
     let bones = VrmSpringBones {

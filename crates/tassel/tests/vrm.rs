@@ -77,6 +77,7 @@ fn spec_mode_matches_the_equations_worked_by_hand() {
         gravity_power: g as f32,
         gravity_dir: Vec3::NEG_Y,
         drag_force: drag as f32,
+        limit: None,
     };
     // A sphere on the root, placed where the tail swings through.
     let bones = VrmSpringBones {

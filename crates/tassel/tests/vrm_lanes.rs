@@ -319,6 +319,7 @@ fn every_part() -> (Skeleton, VrmSpringBones) {
                 gravity_power: 0.5 + 0.25 * (k % 3) as f32,
                 gravity_dir: Vec3::new(0.1 * (seed % 3) as f32, -1.0, 0.0),
                 drag_force: 0.1 + 0.1 * (seed % 5) as f32,
+                limit: None,
             })
             .collect();
         VrmSpring {

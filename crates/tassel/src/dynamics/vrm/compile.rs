@@ -2,6 +2,7 @@
 //! the update must visit them (ancestors first), with the rest data the spec's
 //! initialisation records.
 
+use super::limit::LinkLimit;
 use super::settings::{VrmOptions, VrmShape, VrmSpringBones, VrmTail};
 use crate::error::Result;
 use crate::math::{normalize_or, Transform};
@@ -39,6 +40,8 @@ pub struct VrmLink {
     pub center: Option<usize>,
     /// Range in [`VrmRig::link_colliders`].
     pub colliders: Range<usize>,
+    /// The joint's swing limit (`VRMC_springBone_limit`), compiled.
+    pub limit: Option<LinkLimit>,
 }
 
 /// VRM spring bones compiled for one skeleton. Shareable between characters.
@@ -91,6 +94,8 @@ impl VrmRig {
                     ),
                     VrmTail::Local(p) => (None, p),
                 };
+                let bone_axis = normalize_or(tail_local, Vec3::Y);
+                let rest_local = skeleton.rest()[j.joint];
                 let start = link_colliders.len();
                 link_colliders.extend_from_slice(&cols);
                 links.push(VrmLink {
@@ -98,8 +103,8 @@ impl VrmRig {
                     parent: skeleton.parent(j.joint),
                     tail_joint,
                     tail_local,
-                    bone_axis: normalize_or(tail_local, Vec3::Y),
-                    rest_local: skeleton.rest()[j.joint],
+                    bone_axis,
+                    rest_local,
                     spring: si,
                     hit_radius: j.hit_radius,
                     stiffness: j.stiffness,
@@ -107,6 +112,9 @@ impl VrmRig {
                     drag_force: j.drag_force,
                     center: s.center,
                     colliders: start..link_colliders.len(),
+                    limit: j
+                        .limit
+                        .map(|lim| LinkLimit::new(&lim, rest_local.rotation, bone_axis)),
                 });
             }
         }
@@ -127,6 +135,11 @@ impl VrmRig {
         };
         rig.lanes = crate::dynamics::vrm::lanes::springs::SpringLanes::new(skeleton, &rig);
         Ok(rig)
+    }
+
+    /// Whether a link has a swing limit (`VRMC_springBone_limit`).
+    pub fn has_limits(&self) -> bool {
+        self.links.iter().any(|l| l.limit.is_some())
     }
 
     /// Whether the rig has `VRMC_node_constraint` constraints (they turn joints that are

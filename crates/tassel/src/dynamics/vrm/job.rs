@@ -336,9 +336,10 @@ impl VrmJob<'_> {
             (Some(_), false) if lane_output && models_given => {}
             _ => crate::pose::local_to_model_into(skeleton, locals, models),
         }
-        if opts.mode == VrmMode::Fixed && !rig.link_colliders.is_empty() {
+        if opts.mode == VrmMode::Fixed && (!rig.link_colliders.is_empty() || rig.has_limits()) {
             // The interpolated pose lags a step and may cut through a collider between
-            // two steps: it is pushed out by this frame's colliders like a step's tail.
+            // two steps (or leave a limit): it is pushed out by this frame's colliders
+            // (and limited) like a step's tail.
             collide_output(skeleton, rig, state, &component, w, locals, models);
         }
         if opts.mode == VrmMode::ThreeVrm {
@@ -377,7 +378,7 @@ fn collide_output(
     }
     let mut stale_from = sk.len();
     for (i, l) in rig.links.iter().enumerate() {
-        if l.colliders.is_empty() {
+        if l.colliders.is_empty() && l.limit.is_none() {
             continue;
         }
         if stale_from <= l.joint {
@@ -387,17 +388,22 @@ fn collide_output(
         let joint_world = *component * models[l.joint];
         let tail = joint_world.transform_point(l.tail_local);
         let parent_world = parent_world(l, component, models);
+        let position = joint_world.translation;
+        // The blend between two limited steps can leave the limit: the output is limited
+        // too, then pushed (and limited after each push) like a step's tail.
+        let inside = limited(l, parent_world.rotation, position, tail, state.length[i]);
         let (next, acted) = collide_tail(
             rig,
             state,
             l,
-            joint_world.translation,
+            parent_world.rotation,
+            position,
             state.length[i],
             rest_dir(l, &parent_world),
-            tail,
+            inside,
             true,
         );
-        if !acted {
+        if !acted && inside == tail {
             continue;
         }
         turn_toward(l, &parent_world, next, locals, models);
@@ -521,7 +527,19 @@ fn update(
                 current + inertia + stiffness + external - position,
                 rest_dir,
             ) * length;
-        let (next, _) = collide_tail(rig, state, l, position, length, rest_dir, next, exact);
+        // The draft limit (`VRMC_springBone_limit`): after inertia, and after each push.
+        let next = limited(l, parent_world.rotation, position, next, length);
+        let (next, _) = collide_tail(
+            rig,
+            state,
+            l,
+            parent_world.rotation,
+            position,
+            length,
+            rest_dir,
+            next,
+            exact,
+        );
 
         let to_stored = |t: Vec3| center.map_or(t, |c| c.inverse_transform_point(t));
         state.prev_tail[i] = state.current_tail[i];
@@ -556,6 +574,7 @@ fn collide_tail(
     rig: &VrmRig,
     state: &VrmState,
     l: &VrmLink,
+    parent_rotation: Quat,
     position: Vec3,
     length: f32,
     rest_dir: Vec3,
@@ -567,15 +586,28 @@ fn collide_tail(
         let (dir, dist) = state.placed[c].collision(tail, l.hit_radius);
         if dist < 0.0 {
             tail = position + normalize_or(tail - dir * dist - position, rest_dir) * length;
+            tail = limited(l, parent_rotation, position, tail, length);
             acted = true;
         }
     }
     if exact {
-        let settled = settle(rig, state, l, position, length, tail);
-        acted |= settled != tail;
+        let mut settled = settle(rig, state, l, position, length, tail);
+        if settled != tail {
+            settled = limited(l, parent_rotation, position, settled, length);
+            acted = true;
+        }
         tail = settled;
     }
     (tail, acted)
+}
+
+/// The tail kept within the link's limit, if it has one (`VRMC_springBone_limit`).
+#[inline]
+fn limited(l: &VrmLink, parent_rotation: Quat, position: Vec3, tail: Vec3, length: f32) -> Vec3 {
+    match &l.limit {
+        Some(limit) => limit.apply(parent_rotation, position, tail, length),
+        None => tail,
+    }
 }
 
 /// Turns the link's joint so that its bone points at `tail` (world): the rest local

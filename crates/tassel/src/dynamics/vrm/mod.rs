@@ -56,12 +56,14 @@ mod compile;
 mod constraint;
 mod job;
 pub(crate) mod lanes;
+mod limit;
 mod settings;
 
 pub use collide::PlacedVrmCollider;
 pub use compile::{VrmLink, VrmRig};
 pub use constraint::{ConstraintKind, NodeConstraint};
 pub use job::{VrmJob, VrmState};
+pub use limit::{axis_rotation, LinkLimit, VrmLimit, VrmLimitShape};
 pub use settings::{
     VrmCollider, VrmColliderGroup, VrmJoint, VrmMode, VrmOptions, VrmShape, VrmSpring,
     VrmSpringBones, VrmTail,

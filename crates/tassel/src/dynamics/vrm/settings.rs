@@ -7,6 +7,7 @@ use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
 use super::constraint::NodeConstraint;
+use super::limit::VrmLimit;
 
 /// All spring bones of one model (`VRMC_springBone` 1.0 or VRM 0.x `secondaryAnimation`).
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
@@ -113,6 +114,9 @@ pub struct VrmJoint {
     pub gravity_dir: Vec3,
     /// Share of the last frame's motion lost per frame, 0..=1.
     pub drag_force: f32,
+    /// How far the joint may swing (`VRMC_springBone_limit`); `None`: anywhere.
+    #[serde(default)]
+    pub limit: Option<VrmLimit>,
 }
 
 impl Default for VrmJoint {
@@ -126,6 +130,7 @@ impl Default for VrmJoint {
             gravity_power: 0.0,
             gravity_dir: Vec3::new(0.0, -1.0, 0.0),
             drag_force: 0.5,
+            limit: None,
         }
     }
 }
@@ -313,6 +318,9 @@ impl VrmSpringBones {
                         "{what}: dragForce {} must be in 0..=1",
                         j.drag_force
                     ));
+                }
+                if let Some(limit) = &j.limit {
+                    limit.check().or_else(|m| bad(format!("{what}: {m}")))?;
                 }
             }
         }

@@ -3,8 +3,8 @@
 //! bits. Shared by [`super::VrmCrowd`] (a lane per character) and the single character's
 //! springs side by side ([`super::springs`]).
 
-use crate::dynamics::vrm::VrmShape;
-use crate::lanes::{closest_point_on_segment, differs, Lane, Mask, F, V3};
+use crate::dynamics::vrm::{LinkLimit, VrmShape};
+use crate::lanes::{closest_point_on_segment, differs, Lane, Mask, F, LANES, Q, V3};
 use glam::Vec3;
 
 /// A collider placed in world space, per lane: `a` (centre, capsule head, plane point) and
@@ -200,6 +200,7 @@ pub(crate) fn collide_tail<T: Lane>(
     rest_dir: V3<T>,
     mut tail: V3<T>,
     exact: bool,
+    limit: Option<(&LinkLimit, Q<T>)>,
 ) -> (V3<T>, T::M) {
     let mut acted = <T::M as Mask>::NONE;
     for &c in colliders {
@@ -209,8 +210,12 @@ pub(crate) fn collide_tail<T: Lane>(
             let pushed = position + (tail - dir * dist - position).normalize_or(rest_dir) * length;
             tail = V3::select(hit, pushed, tail);
             acted = acted.or(hit);
+            if let Some((lim, parent_r)) = limit {
+                tail = limit_lanes(lim, parent_r, position, tail, length, hit);
+            }
         }
     }
+    let before_settling = tail;
     // A lane where no collider acted kept its tail, at which every collider's distance
     // was found not negative: no penetration to settle (the scalar settling's first pass
     // changes nothing and stops). So with no lane acted, the settling is skipped.
@@ -242,8 +247,37 @@ pub(crate) fn collide_tail<T: Lane>(
                 break;
             }
         }
+        if let Some((lim, parent_r)) = limit {
+            let moved = differs(tail, before_settling);
+            tail = limit_lanes(lim, parent_r, position, tail, length, moved);
+        }
     }
     (tail, acted)
+}
+
+/// [`LinkLimit::apply`] on the lanes in `lanes`, lane by lane with the scalar code (the
+/// scalar bits; limits are rare enough that their trigonometry need not be in lanes).
+#[inline(always)]
+pub(crate) fn limit_lanes<T: Lane>(
+    lim: &LinkLimit,
+    parent_r: Q<T>,
+    position: V3<T>,
+    tail: V3<T>,
+    length: T,
+    lanes: T::M,
+) -> V3<T> {
+    let m = lanes.m();
+    if !m.any() {
+        return tail;
+    }
+    let (r, p, t, len) = (parent_r.f(), position.f(), tail.f(), length.f());
+    let mut out = t;
+    for l in 0..LANES {
+        if m.get(l) {
+            out.set(l, lim.apply(r.get(l), p.get(l), t.get(l), len.get(l)));
+        }
+    }
+    V3::of(out)
 }
 
 impl Default for Placed {

@@ -5,7 +5,7 @@
 //! centres, tails) is the same for all lanes. Branches that depend on a character's state
 //! (a contact, a fallback, a reset) are computed for every lane and selected per lane.
 
-use super::contact::{collide_tail, Placed};
+use super::contact::{collide_tail, limit_lanes, Placed};
 use super::pack::{LinkPlan, Pack, Plan, Scratch};
 use crate::dynamics::vrm::{VrmMode, VrmRig, VrmShape};
 use crate::error::Error;
@@ -13,7 +13,7 @@ use crate::error::Error;
 use crate::lanes::avx::Fa;
 #[cfg(target_arch = "x86_64")]
 use crate::lanes::avx512::Fz;
-use crate::lanes::{rotation_arc_from, Isa, Lane, Mask, Trs, F, LANES, M, Q, V3};
+use crate::lanes::{differs, rotation_arc_from, Isa, Lane, Mask, Trs, F, LANES, M, Q, V3};
 use crate::math::Transform;
 use crate::pose::CrowdPose;
 use crate::skeleton::Skeleton;
@@ -522,9 +522,18 @@ impl Ctx<'_> {
         };
         let next = position
             + (current + inertia + stiffness + external - position).normalize_or(rest_dir) * length;
+        // The draft limit after inertia (every lane: those not active are dropped below).
+        let next = match &lp.limit {
+            Some(lim) => {
+                let every = <T::M as Mask>::NONE.not();
+                limit_lanes(lim, parent_world.r, position, next, length, every)
+            }
+            None => next,
+        };
         let (next, _) = self.collide_tail(
             lp,
             placed,
+            parent_world.r,
             position,
             length,
             rest_dir,
@@ -562,6 +571,7 @@ impl Ctx<'_> {
         &self,
         lp: &LinkPlan,
         placed: &[Placed],
+        parent_r: Q<T>,
         position: V3<T>,
         length: T,
         rest_dir: V3<T>,
@@ -578,6 +588,7 @@ impl Ctx<'_> {
             rest_dir,
             tail,
             exact,
+            lp.limit.as_ref().map(|lim| (lim, parent_r)),
         )
     }
 
@@ -694,7 +705,7 @@ impl Ctx<'_> {
             pack.out_rotation[i] = Q::select(full, pack.rotation[i], between);
         }
         self.output_pose(pack, s);
-        if self.rig.link_colliders.is_empty() {
+        if self.rig.link_colliders.is_empty() && !self.rig.has_limits() {
             return;
         }
         // The interpolated pose may cut through a collider between two steps: each tail is
@@ -717,7 +728,7 @@ impl Ctx<'_> {
                 continue;
             };
             let lp = &plan.links[i];
-            if lp.colliders.is_empty() {
+            if lp.colliders.is_empty() && lp.limit.is_none() {
                 continue;
             }
             let joint_world = comp.mul(&s.models[slot]);
@@ -727,15 +738,33 @@ impl Ctx<'_> {
                 None => comp,
             };
             let rest_dir = parent_world.r.mul_vec3(V3::splat(lp.rest_bone));
+            // The blend between two limited steps can leave the limit (the scalar job's
+            // `collide_output`).
+            let inside = match &lp.limit {
+                Some(lim) => {
+                    let every = M::NONE.not();
+                    limit_lanes(
+                        lim,
+                        parent_world.r,
+                        joint_world.t,
+                        tail,
+                        pack.length[i],
+                        every,
+                    )
+                }
+                None => tail,
+            };
             let (next, acted) = self.collide_tail(
                 lp,
                 &s.placed,
+                parent_world.r,
                 joint_world.t,
                 pack.length[i],
                 rest_dir,
-                tail,
+                inside,
                 true,
             );
+            let acted = acted.or(differs(inside, tail));
             if !acted.any() {
                 continue;
             }

@@ -4,7 +4,7 @@
 
 use super::contact::Placed;
 use crate::dynamics::path::CharacterPath;
-use crate::dynamics::vrm::{VrmRig, VrmShape};
+use crate::dynamics::vrm::{LinkLimit, VrmRig, VrmShape};
 use crate::error::{Error, Result};
 use crate::lanes::{Trs, F, LANES, Q, V3};
 use crate::math::{normalize_or, Transform};
@@ -29,6 +29,8 @@ pub(crate) struct LinkPlan {
     pub(crate) keep: f32,
     pub(crate) hit_radius: f32,
     pub(crate) colliders: std::ops::Range<usize>,
+    /// The link's swing limit, applied lane by lane with the scalar code.
+    pub(crate) limit: Option<LinkLimit>,
 }
 
 /// The joints a crowd computes (every link, tail, centre and collider joint and their
@@ -118,6 +120,7 @@ impl Plan {
                 keep: 1.0 - l.drag_force,
                 hit_radius: l.hit_radius,
                 colliders: l.colliders.clone(),
+                limit: l.limit,
             });
         }
         let mut affected = vec![false; joints.len()];

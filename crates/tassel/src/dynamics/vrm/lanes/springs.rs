@@ -146,6 +146,11 @@ impl SpringLanes {
     /// results (see the module's documentation) or there is nothing to simulate.
     pub(crate) fn new(sk: &Skeleton, rig: &VrmRig) -> Option<SpringLanes> {
         let links = &rig.links;
+        if rig.has_limits() {
+            // Limits run in the scalar update (several springs side by side would apply
+            // them lane by lane anyway); the crowd's lanes carry them (`frame.rs`).
+            return None;
+        }
         let (first, last) = (links.first()?.joint, links.last()?.joint);
         let n = sk.len();
         if (first + 1..=last).any(|k| sk.parent(k).is_none()) {
@@ -430,6 +435,7 @@ impl SpringLanes {
                         rest_dir,
                         tail,
                         true,
+                        None,
                     );
                     if acted.any() {
                         let rotation = row.turn(&parent_world, next);
@@ -543,6 +549,7 @@ impl SpringLanes {
                     rest_dir,
                     next,
                     exact,
+                    None,
                 );
                 let new_stored = match &center {
                     Some(c) => c.inverse_transform_point(next),
