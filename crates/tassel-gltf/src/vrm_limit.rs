@@ -100,7 +100,8 @@ pub(crate) fn read_limit(
                     "{bat}.rotation is zero; it must be a unit quaternion"
                 ));
             }
-            q.normalize()
+            // As the file gives it: the solver normalises it when compiling.
+            q
         }
         Some(other) => {
             return Err(format!(

@@ -226,3 +226,53 @@ pub fn outline(c: &PlacedCollider) -> Outline {
         },
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use tassel::dynamics::vrm::{
+        VrmJoint, VrmLimit, VrmLimitShape, VrmOptions, VrmSpring, VrmSpringBones, VrmTail,
+    };
+    use tassel::dynamics::RigSettings;
+    use tassel::SkeletonBuilder;
+
+    /// A hair bone 0.2 m long hanging along −Z of its joint, limited to a 0.3 rad cone:
+    /// the figure's limit is a ring of points 0.2 m from the joint, each 0.3 rad from the
+    /// rest bone (the cone's rim, computed by hand: the frame turns +Y onto the bone axis).
+    #[test]
+    fn a_cone_limit_is_drawn_as_its_rim_at_the_bone_length() {
+        let mut b = SkeletonBuilder::new();
+        b.add("root", None, Transform::IDENTITY);
+        b.add("hair", Some(0), Transform::from_translation(Vec3::Y));
+        let (sk, _) = b.build().unwrap();
+        let bones = VrmSpringBones {
+            springs: vec![VrmSpring {
+                name: "hair".into(),
+                joints: vec![VrmJoint {
+                    joint: 1,
+                    tail: VrmTail::Local(Vec3::new(0.0, 0.0, -0.2)),
+                    limit: Some(VrmLimit::new(VrmLimitShape::Cone { angle: 0.3 })),
+                    ..Default::default()
+                }],
+                ..Default::default()
+            }],
+            ..Default::default()
+        };
+        let mut sim =
+            CharacterSim::with_vrm(sk, &RigSettings::default(), &bones, VrmOptions::default())
+                .unwrap();
+        let at = Transform::from_translation(Vec3::new(2.0, 0.0, 0.0));
+        let rest = sim.skeleton().rest().to_vec();
+        sim.frame(&rest, at, 0.0).unwrap();
+        let figure = Figure::from_sim(&sim, &at, 0.0);
+        assert_eq!(figure.limits.len(), 1);
+        let l = &figure.limits[0];
+        assert!((l.joint - Vec3::new(2.0, 1.0, 0.0)).length() < 1e-6);
+        assert!(l.rim.len() >= 24);
+        for p in &l.rim {
+            let d = *p - l.joint;
+            assert!((d.length() - 0.2).abs() < 1e-5, "{d}");
+            assert!((d.angle_between(Vec3::NEG_Z) - 0.3).abs() < 1e-4, "{d}");
+        }
+    }
+}
