@@ -3,6 +3,8 @@
 //!
 //! - [`VrmSpringBones`]: the file's springs, joints and colliders as plain data (the
 //!   `tassel-gltf` crate reads them from a `.vrm`).
+//! - [`VrmLimit`]: a joint's swing limit (`VRMC_springBone_limit`, draft 1.0: cone, hinge,
+//!   spherical), applied after inertia and after each collider push in every mode.
 //! - [`VrmRig`]: compiled for a skeleton; [`VrmState`]: one character's tails;
 //!   [`VrmJob`]: one frame.
 //! - [`VrmMode::Spec`] runs the update once per frame exactly as the specification and
