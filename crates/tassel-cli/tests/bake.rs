@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{accessor_bytes, glb_chunks, read_floats, tassel, testdata, tmp, validate};
+use common::{accessor_bytes, glb_chunks, read_floats, run_ok, tassel, testdata, tmp, validate};
 use serde_json::Value;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -366,25 +366,20 @@ fn bake_vrm_keeps_and_respects_spring_bone_limits() {
     let axis = glam::Vec3::new(t[0], t[1], t[2]).normalize();
     assert!(json["nodes"][node as usize].get("rotation").is_none());
     let largest_swing = |file: &Path, out: &Path| -> f32 {
-        let run = tassel()
-            .arg("bake")
-            .arg(file)
-            .args([
-                "--mode",
-                "fixed",
-                "--warmup",
-                "0",
-                "--sway",
-                "0.3,0,0.2",
-                "-o",
-            ])
-            .arg(out)
-            .output()
-            .unwrap();
-        assert!(
-            run.status.success(),
-            "{}",
-            String::from_utf8_lossy(&run.stderr)
+        run_ok(
+            tassel()
+                .arg("bake")
+                .arg(file)
+                .args([
+                    "--mode",
+                    "fixed",
+                    "--warmup",
+                    "0",
+                    "--sway",
+                    "0.3,0,0.2",
+                    "-o",
+                ])
+                .arg(out),
         );
         let (oj, ob) = glb_chunks(&std::fs::read(out).unwrap());
         let (ij, _) = glb_chunks(&std::fs::read(file).unwrap());

@@ -165,15 +165,15 @@ impl Figure {
         } else {
             colliders.extend(sim.cloth_state().placed_colliders().iter().map(outline));
         }
+        // `vrm_limit_outline` is under the sim's own transform: re-placed here under
+        // `component`, as the bones are.
+        let to_here = *component * sim.component().inverse();
         let limits = sim
             .vrm()
             .links
             .iter()
             .filter_map(|l| {
                 let rim = sim.vrm_limit_outline(l.joint, 24)?;
-                // `vrm_limit_outline` is under the sim's own transform: re-placed here
-                // under `component`, as the bones are.
-                let to_here = *component * sim.component().inverse();
                 Some(LimitOutline {
                     joint: world(models[l.joint].translation),
                     rim: rim

@@ -81,13 +81,20 @@ fn ref_limit(
     tail: DVec3,
     length: f64,
 ) -> DVec3 {
-    // A rotation: unit (the f32 inputs are unit to 6e-8 only, and the draft's cone and
-    // hinge formulas divide by 1 − y², which a non-unit direction throws off near the axis).
-    let rotation =
-        (parent_rotation * rest_rotation * ref_axis_rotation(bone_axis) * dq(limit.rotation))
-            .normalize();
-    let d = rotation.inverse() * (tail - position).normalize();
-    ref_limit_in_frame(limit, rotation, position, d, length).0
+    let (rotation, d) = ref_frame(
+        limit,
+        parent_rotation,
+        rest_rotation,
+        bone_axis,
+        position,
+        tail,
+    );
+    let d = match limit.shape {
+        VrmLimitShape::Cone { angle } => ref_cone(d, angle as f64),
+        VrmLimitShape::Hinge { angle } => ref_hinge(d, angle as f64),
+        VrmLimitShape::Spherical { pitch, yaw } => ref_spherical(d, pitch as f64, yaw as f64),
+    };
+    position + rotation * d * length
 }
 
 /// How well the limit's answer is determined by `d` (limit frame): the distance from the
@@ -108,23 +115,8 @@ fn conditioning(limit: &VrmLimit, d: DVec3) -> f64 {
     }
 }
 
-fn ref_limit_in_frame(
-    limit: &VrmLimit,
-    rotation: DQuat,
-    position: DVec3,
-    d: DVec3,
-    length: f64,
-) -> (DVec3, f64) {
-    let condition = conditioning(limit, d);
-    let d = match limit.shape {
-        VrmLimitShape::Cone { angle } => ref_cone(d, angle as f64),
-        VrmLimitShape::Hinge { angle } => ref_hinge(d, angle as f64),
-        VrmLimitShape::Spherical { pitch, yaw } => ref_spherical(d, pitch as f64, yaw as f64),
-    };
-    (position + rotation * d * length, condition)
-}
-
-/// The limit's frame in world space and the tail's direction in it (f64).
+/// The limit's frame in world space (the draft's `rotation`) and the tail's direction in
+/// it (f64).
 fn ref_frame(
     limit: &VrmLimit,
     parent_rotation: DQuat,
@@ -132,13 +124,13 @@ fn ref_frame(
     bone_axis: DVec3,
     position: DVec3,
     tail: DVec3,
-) -> DVec3 {
+) -> (DQuat, DVec3) {
     // A rotation: unit (the f32 inputs are unit to 6e-8 only, and the draft's cone and
     // hinge formulas divide by 1 − y², which a non-unit direction throws off near the axis).
     let rotation =
         (parent_rotation * rest_rotation * ref_axis_rotation(bone_axis) * dq(limit.rotation))
             .normalize();
-    rotation.inverse() * (tail - position).normalize()
+    (rotation, rotation.inverse() * (tail - position).normalize())
 }
 
 /// A small deterministic generator (no global RNG).
@@ -216,7 +208,7 @@ fn each_limit_matches_the_drafts_reference_code() {
                 tail.as_dvec3(),
                 length as f64,
             );
-            let d = ref_frame(
+            let (_, d) = ref_frame(
                 &limit,
                 dq(parent),
                 dq(rest),
@@ -434,7 +426,7 @@ fn reference_run(
                 let (parent_q, position) = (w[j - 1].1, w[j].0);
                 let mut limit = |t: DVec3| match &limits[i] {
                     Some(l) => {
-                        let d = ref_frame(l, parent_q, rest[j].1, axis[i], position, t);
+                        let (_, d) = ref_frame(l, parent_q, rest[j].1, axis[i], position, t);
                         // Only where the limit acts does its conditioning matter.
                         let limited =
                             ref_limit(l, parent_q, rest[j].1, axis[i], position, t, length[i]);

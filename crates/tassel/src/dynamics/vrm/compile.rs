@@ -66,6 +66,8 @@ pub struct VrmRig {
     /// The links as SIMD lane rows (several springs side by side), where the rig allows.
     pub(crate) lanes: Option<crate::dynamics::vrm::lanes::springs::SpringLanes>,
     joint_count: usize,
+    /// Whether a link has a limit (read every frame: found once here).
+    limited: bool,
 }
 
 impl VrmRig {
@@ -132,14 +134,16 @@ impl VrmRig {
             )?,
             lanes: None,
             joint_count: skeleton.len(),
+            limited: false,
         };
+        rig.limited = rig.links.iter().any(|l| l.limit.is_some());
         rig.lanes = crate::dynamics::vrm::lanes::springs::SpringLanes::new(skeleton, &rig);
         Ok(rig)
     }
 
     /// Whether a link has a swing limit (`VRMC_springBone_limit`).
     pub fn has_limits(&self) -> bool {
-        self.links.iter().any(|l| l.limit.is_some())
+        self.limited
     }
 
     /// Whether the rig has `VRMC_node_constraint` constraints (they turn joints that are
