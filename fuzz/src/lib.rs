@@ -117,8 +117,75 @@ pub fn ffi_load(data: &[u8]) {
                 assert_eq!(short, -1, "ffi_load: a short buffer was taken");
             }
             assert!(tassel_joint_name(c, n).is_null());
+            ffi_crowd(c, &locals);
             tassel_character_free(c);
         }
+    }
+}
+
+/// A crowd of two characters of `kind` for a few frames (`rest`: the kind's rest locals):
+/// every output finite, a short buffer refused.
+///
+/// # Safety
+/// `kind` is a live character; `rest` holds 10 floats a joint.
+#[allow(unsafe_code)]
+unsafe fn ffi_crowd(kind: *mut tassel_ffi::abi::TasselCharacter, rest: &[f32]) {
+    use tassel_ffi::abi::*;
+    // SAFETY: the caller's promise; every buffer is as long as the length given.
+    unsafe {
+        let crowd = tassel_crowd_new(kind);
+        assert!(!crowd.is_null(), "ffi_load: no crowd of a loaded character");
+        assert_eq!(tassel_crowd_add(crowd), 0);
+        assert_eq!(tassel_crowd_add(crowd), 1);
+        let mut read = vec![0usize; tassel_crowd_read_joint_count(crowd)];
+        assert_eq!(
+            tassel_crowd_read_joints(crowd, read.as_mut_ptr(), read.len()),
+            0
+        );
+        let written = tassel_crowd_written_joint_count(crowd);
+        let mut locals = Vec::new();
+        for _ in 0..2 {
+            for &j in &read {
+                locals.extend_from_slice(&rest[j * 10..(j + 1) * 10]);
+            }
+        }
+        let mut out = vec![0.0f32; 2 * written * 10];
+        for f in 0..3 {
+            let x = 0.3 * (f as f32 * 0.9).sin();
+            let roots = [x, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0].repeat(2);
+            let code = tassel_crowd_frame(
+                crowd,
+                roots.as_ptr(),
+                roots.len(),
+                locals.as_ptr(),
+                locals.len(),
+                out.as_mut_ptr(),
+                out.len(),
+                1.0 / 30.0,
+            );
+            assert!(code >= 0, "ffi_load: a crowd frame of good lengths failed");
+            if code == 0 {
+                assert!(
+                    out.iter().all(|v| v.is_finite()),
+                    "ffi_load: a non-finite crowd output"
+                );
+            }
+            let short = tassel_crowd_frame(
+                crowd,
+                roots.as_ptr(),
+                roots.len(),
+                locals.as_ptr(),
+                locals.len().saturating_sub(1),
+                out.as_mut_ptr(),
+                out.len(),
+                1.0 / 30.0,
+            );
+            assert!(
+                short == -1 || locals.is_empty(),
+                "ffi_load: a short crowd buffer was taken"
+            );
+        }
+        tassel_crowd_free(crowd);
     }
 }
 

@@ -1,6 +1,6 @@
 // `npm run bench` (or `node bench/bench.mjs [FRAMES] [RUNS]`): three-vrm's spring update
 // against Tassel's in Node, side by side in this process (see core.mjs).
-import { TasselSpringBoneManager } from '../dist/index.js';
+import { TasselSpringBoneManager, TasselCrowd } from '../dist/index.js';
 import { loadGltfBytes, THREE } from '../test/gltf.mjs';
 import '../test/load.mjs';
 import { runBench } from './core.mjs';
@@ -8,4 +8,4 @@ import { runBench } from './core.mjs';
 const frames = Number(process.argv[2] ?? 200);
 const runs = Number(process.argv[3] ?? 7);
 console.log(`Node ${process.version}, three r${THREE.REVISION}`);
-await runBench({ frames, runs, loadGltfBytes, TasselSpringBoneManager, THREE });
+await runBench({ frames, runs, loadGltfBytes, TasselSpringBoneManager, TasselCrowd, THREE });

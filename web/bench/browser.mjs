@@ -20,7 +20,8 @@ try {
   const { rows, userAgent } = await page.evaluate(() => window.tasselBench);
   console.log(userAgent);
   for (const r of rows) {
-    console.log(`${r.characters} x ${r.joints} joints: three-vrm ${r['three-vrm 3.5.5'].toFixed(1)} ns/joint, Tassel three-vrm mode ${r['Tassel three-vrm'].toFixed(1)} (${r.speedup_three_vrm_mode.toFixed(1)}x), Tassel fixed ${r['Tassel fixed'].toFixed(1)} (${r.speedup_fixed.toFixed(1)}x)`);
+    const others = Object.keys(r.speedup).map((k) => `${k} ${r[k].toFixed(1)} (${r.speedup[k].toFixed(1)}x)`);
+    console.log(`${r.characters} x ${r.joints} joints: three-vrm ${r['three-vrm 3.5.5'].toFixed(1)} ns/joint; ${others.join(', ')}`);
   }
 } finally {
   await browser.close();

@@ -1,39 +1,53 @@
 // The side-by-side benchmark of three-vrm's spring update and Tassel's (WebAssembly), in
 // one JavaScript process (Node: bench.mjs; Chromium: index.html): N characters of the
 // 16 x 8-joint rig with 8 colliders (rig.mjs) swaying on their roots; per frame, every
-// character's manager.update(1/60) — Tassel's including the transfer of transforms from
-// and to the three.js objects. Runs are interleaved (three-vrm, Tassel three-vrm mode,
-// Tassel fixed, again...) and each figure is the median over runs, in ns per joint-step
-// (a joint-step: one simulated joint in one update).
+// character's manager.update(1/60), or one TasselCrowd.update(1/60) for all — Tassel's
+// including the transfer of transforms from and to the three.js objects. Runs are
+// interleaved (three-vrm, Tassel three-vrm mode, Tassel fixed, the crowd in both, again...)
+// and each figure is the median over runs, in ns per joint-step (a joint-step: one
+// simulated joint in one update).
 import { CHAINS, JOINTS_PER_CHAIN, springRigGlb } from './rig.mjs';
 
 const JOINTS = CHAINS * JOINTS_PER_CHAIN;
 
+// What is measured: three-vrm's manager per character; Tassel's manager per character
+// (one WebAssembly call each); Tassel's crowd (one call a frame for all characters).
+const KINDS = {
+  'three-vrm 3.5.5': { mode: null, crowd: false },
+  'Tassel three-vrm': { mode: 'three-vrm', crowd: false },
+  'Tassel fixed': { mode: 'fixed', crowd: false },
+  'crowd three-vrm': { mode: 'three-vrm', crowd: true },
+  'crowd fixed': { mode: 'fixed', crowd: true },
+};
+
 async function characters(kind, n, ctx) {
+  const { mode, crowd: inCrowd } = KINDS[kind];
   const bytes = springRigGlb();
-  const out = [];
+  const crowd = inCrowd ? await ctx.TasselCrowd.fromBytes(bytes, { mode }) : null;
+  const chars = [];
   for (let i = 0; i < n; i++) {
     const { gltf, manager } = await ctx.loadGltfBytes(bytes);
     let m = manager;
-    if (kind !== 'three-vrm 3.5.5') {
-      m = await ctx.TasselSpringBoneManager.fromGLTF(gltf, bytes, { mode: kind === 'Tassel three-vrm' ? 'three-vrm' : 'fixed' });
-    }
+    if (crowd) m = crowd.add(gltf);
+    else if (mode) m = await ctx.TasselSpringBoneManager.fromGLTF(gltf, bytes, { mode });
     gltf.scene.position.set(i * 0.7, 0, 0);
     gltf.scene.updateMatrixWorld(true);
-    out.push({ scene: gltf.scene, manager: m, x: i * 0.7 });
+    chars.push({ scene: gltf.scene, manager: m, x: i * 0.7 });
   }
-  return out;
+  return { chars, crowd };
 }
 
-function run(chars, frames, dt, t0) {
+function run(set, frames, dt, t0) {
+  const { chars, crowd } = set;
   const start = performance.now();
   for (let f = 0; f < frames; f++) {
     const t = t0 + f * dt;
     for (const c of chars) {
       c.scene.position.x = c.x + 0.3 * Math.sin(2 * Math.PI * t);
       c.scene.updateMatrix();
-      c.manager.update(dt);
+      if (!crowd) c.manager.update(dt);
     }
+    if (crowd) crowd.update(dt);
   }
   return performance.now() - start;
 }
@@ -44,7 +58,7 @@ function median(v) {
 }
 
 export async function runBench({ counts = [1, 100], frames = 200, runs = 7, log = console.log, ...ctx }) {
-  const kinds = ['three-vrm 3.5.5', 'Tassel three-vrm', 'Tassel fixed'];
+  const kinds = Object.keys(KINDS);
   const results = [];
   for (const n of counts) {
     const sets = {};
@@ -65,11 +79,14 @@ export async function runBench({ counts = [1, 100], frames = 200, runs = 7, log 
     }
     const row = { characters: n, joints: JOINTS };
     for (const k of kinds) row[k] = median(times[k]);
-    row.speedup_three_vrm_mode = row['three-vrm 3.5.5'] / row['Tassel three-vrm'];
-    row.speedup_fixed = row['three-vrm 3.5.5'] / row['Tassel fixed'];
-    log(`${n} x ${JOINTS} joints: three-vrm ${row['three-vrm 3.5.5'].toFixed(1)} ns/joint, Tassel three-vrm mode ${row['Tassel three-vrm'].toFixed(1)} (${row.speedup_three_vrm_mode.toFixed(1)}x), Tassel fixed ${row['Tassel fixed'].toFixed(1)} (${row.speedup_fixed.toFixed(1)}x)`);
+    const base = row['three-vrm 3.5.5'];
+    row.speedup = Object.fromEntries(kinds.slice(1).map((k) => [k, base / row[k]]));
+    log(`${n} x ${JOINTS} joints: three-vrm ${base.toFixed(1)} ns/joint; ` + kinds.slice(1).map((k) => `${k} ${row[k].toFixed(1)} (${row.speedup[k].toFixed(1)}x)`).join(', '));
     results.push(row);
-    for (const k of kinds) for (const c of sets[k]) c.manager.dispose?.();
+    for (const k of kinds) {
+      for (const c of sets[k].chars) if (!sets[k].crowd) c.manager.dispose?.();
+      sets[k].crowd?.dispose();
+    }
   }
   return results;
 }

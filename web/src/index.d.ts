@@ -46,3 +46,35 @@ export class TasselSpringBoneManager extends Stepped {
 export class TasselCharacter extends Stepped {
   static fromGLTF(gltf: GLTFLike, bytes: ArrayBuffer | Uint8Array, rigToml: string | null, options?: TasselOptions): Promise<TasselCharacter>;
 }
+
+/** Many characters of one file stepped together, one WebAssembly call a frame. */
+export class TasselCrowd {
+  static fromBytes(bytes: ArrayBuffer | Uint8Array, options?: TasselOptions & { rigToml?: string }): Promise<TasselCrowd>;
+  readonly mode: TasselMode;
+  /** 'vrm' or 'chains': side by side in SIMD lanes; 'characters': one after another. */
+  readonly kind: 'vrm' | 'chains' | 'characters';
+  readonly size: number;
+  readonly members: TasselCrowdMember[];
+  /** The last update's error (null when every member stepped). */
+  readonly lastError: string | null;
+  /** Adds a loaded copy of the file (its GLTFLoader result). */
+  add(gltf: GLTFLike): TasselCrowdMember;
+  /** Steps every member; false when some member's input was bad (those keep their pose). */
+  update(delta: number): boolean;
+  dispose(): void;
+}
+
+/** One character of a TasselCrowd; stands in for three-vrm's spring-bone manager (its
+ *  update does nothing: the crowd's update steps it). */
+export class TasselCrowdMember {
+  readonly mode: TasselMode | null;
+  readonly bones: Object3D[];
+  readonly index: number;
+  readonly lastError: string | null;
+  update(delta?: number): boolean;
+  reset(): void;
+  setInitState(): void;
+  teleport(): void;
+  /** Leaves the crowd (the last member takes its place). */
+  dispose(): void;
+}

@@ -119,6 +119,131 @@ function nodeObjects(gltf, count) {
   return objects;
 }
 
+/** The three.js parts of some joints, fetched once: each object's position, quaternion and
+ *  scale, its `matrix` and `matrixWorld` elements and its parent's `matrixWorld` elements,
+ *  in arrays of one type each. The per-frame loops read and write through these (each
+ *  array's elements share one shape), not through the objects themselves, whose classes
+ *  differ (Bone, Object3D, Group, Mesh...) and would make every property access
+ *  megamorphic (measured: the transfer took 2-3x the time). The bones' parents are taken
+ *  as they are when the character is made (as three-vrm reads its joints' structure
+ *  once). */
+class BoneParts {
+  constructor(objects, joints) {
+    this.object = joints.map((j) => objects[j]);
+    this.p = this.object.map((o) => o?.position ?? null);
+    this.q = this.object.map((o) => o?.quaternion ?? null);
+    this.s = this.object.map((o) => o?.scale ?? null);
+    this.m = this.object.map((o) => o?.matrix.elements ?? null);
+    this.w = this.object.map((o) => o?.matrixWorld.elements ?? null);
+    this.pw = this.object.map((o) => o?.parent?.matrixWorld.elements ?? null);
+  }
+
+  /** Part `k`'s local transform into `out[at..at + 10]` (nothing for a joint without an
+   *  object: its value stays). */
+  read(k, out, at) {
+    const p = this.p[k];
+    if (p === null) return;
+    const q = this.q[k], s = this.s[k];
+    out[at] = p.x; out[at + 1] = p.y; out[at + 2] = p.z;
+    out[at + 3] = q._x; out[at + 4] = q._y; out[at + 5] = q._z; out[at + 6] = q._w;
+    out[at + 7] = s.x; out[at + 8] = s.y; out[at + 9] = s.z;
+  }
+
+  /** Whether part `k` still holds `v[at..at + 10]` (as float32: what the module gave). */
+  holds(k, v, at) {
+    const p = this.p[k], q = this.q[k], s = this.s[k];
+    return p !== null
+      && Math.fround(q._x) === v[at + 3] && Math.fround(q._y) === v[at + 4] && Math.fround(q._z) === v[at + 5] && Math.fround(q._w) === v[at + 6]
+      && Math.fround(p.x) === v[at] && Math.fround(p.y) === v[at + 1] && Math.fround(p.z) === v[at + 2]
+      && Math.fround(s.x) === v[at + 7] && Math.fround(s.y) === v[at + 8] && Math.fround(s.z) === v[at + 9];
+  }
+
+  /** Writes part `k`'s local transform from `v[at..at + 10]` and refreshes its `matrix`
+   *  and `matrixWorld` (from its parent's), as three-vrm leaves its spring bones. The
+   *  quaternion is written through its fields: three.js's setter would also recompute the
+   *  Euler `rotation`, which costs more than the whole spring step; `syncRotation` asks
+   *  for it. */
+  write(k, v, at, syncRotation) {
+    const tx = v[at], ty = v[at + 1], tz = v[at + 2];
+    const x = v[at + 3], y = v[at + 4], z = v[at + 5], w = v[at + 6];
+    const sx = v[at + 7], sy = v[at + 8], sz = v[at + 9];
+    const p = this.p[k], q = this.q[k], s = this.s[k];
+    p.x = tx; p.y = ty; p.z = tz;
+    q._x = x; q._y = y; q._z = z; q._w = w;
+    s.x = sx; s.y = sy; s.z = sz;
+    if (syncRotation) this.object[k].rotation.setFromQuaternion(q, undefined, false);
+    // As Matrix4.compose.
+    const m = this.m[k];
+    const x2 = x + x, y2 = y + y, z2 = z + z;
+    const xx = x * x2, xy = x * y2, xz = x * z2;
+    const yy = y * y2, yz = y * z2, zz = z * z2;
+    const wx = w * x2, wy = w * y2, wz = w * z2;
+    const m0 = (1 - (yy + zz)) * sx, m1 = (xy + wz) * sx, m2 = (xz - wy) * sx;
+    const m4 = (xy - wz) * sy, m5 = (1 - (xx + zz)) * sy, m6 = (yz + wx) * sy;
+    const m8 = (xz + wy) * sz, m9 = (yz - wx) * sz, m10 = (1 - (xx + yy)) * sz;
+    m[0] = m0; m[1] = m1; m[2] = m2; m[3] = 0;
+    m[4] = m4; m[5] = m5; m[6] = m6; m[7] = 0;
+    m[8] = m8; m[9] = m9; m[10] = m10; m[11] = 0;
+    m[12] = tx; m[13] = ty; m[14] = tz; m[15] = 1;
+    const r = this.w[k];
+    const a = this.pw[k];
+    if (a === null) {
+      for (let i = 0; i < 16; i++) r[i] = m[i];
+      return;
+    }
+    // As Matrix4.multiplyMatrices(parent.matrixWorld, matrix), the local matrix's last
+    // row being (0 0 0 1).
+    const a11 = a[0], a12 = a[4], a13 = a[8], a14 = a[12];
+    const a21 = a[1], a22 = a[5], a23 = a[9], a24 = a[13];
+    const a31 = a[2], a32 = a[6], a33 = a[10], a34 = a[14];
+    const a41 = a[3], a42 = a[7], a43 = a[11], a44 = a[15];
+    r[0] = a11 * m0 + a12 * m1 + a13 * m2;
+    r[1] = a21 * m0 + a22 * m1 + a23 * m2;
+    r[2] = a31 * m0 + a32 * m1 + a33 * m2;
+    r[3] = a41 * m0 + a42 * m1 + a43 * m2;
+    r[4] = a11 * m4 + a12 * m5 + a13 * m6;
+    r[5] = a21 * m4 + a22 * m5 + a23 * m6;
+    r[6] = a31 * m4 + a32 * m5 + a33 * m6;
+    r[7] = a41 * m4 + a42 * m5 + a43 * m6;
+    r[8] = a11 * m8 + a12 * m9 + a13 * m10;
+    r[9] = a21 * m8 + a22 * m9 + a23 * m10;
+    r[10] = a31 * m8 + a32 * m9 + a33 * m10;
+    r[11] = a41 * m8 + a42 * m9 + a43 * m10;
+    r[12] = a11 * tx + a12 * ty + a13 * tz + a14;
+    r[13] = a21 * tx + a22 * ty + a23 * tz + a24;
+    r[14] = a31 * tx + a32 * ty + a33 * tz + a34;
+    r[15] = a41 * tx + a42 * ty + a43 * tz + a44;
+  }
+}
+
+/** The module's `size_t` list (32 bits in wasm32) that `fill(ptr, count)` writes. */
+function indices(tassel, count, fill, what) {
+  const buf = tassel.copyIn(new Uint8Array(Math.max(count, 1) * 4));
+  try {
+    if (fill(buf[0], count) !== 0) throw tassel.error(what);
+    return Array.from(new Uint32Array(tassel.memory.buffer, buf[0], count));
+  } finally {
+    tassel.free(buf);
+  }
+}
+
+/** A loaded character's joints (the file's nodes): count, parents and depths. */
+function jointTable(tassel, ptr) {
+  const x = tassel.x;
+  const n = x.tassel_joint_count(ptr);
+  const parents = new Int32Array(n);
+  for (let j = 0; j < n; j++) parents[j] = x.tassel_joint_parent(ptr, j);
+  const depth = (j) => (parents[j] < 0 ? 0 : 1 + depth(parents[j]));
+  const depths = Int32Array.from(parents, (_, j) => depth(j));
+  return { n, parents, depths };
+}
+
+/** Joints in the order they are written: parents before children (a child's world matrix
+ *  is made from its parent's, written first). */
+function parentsFirst(joints, depths) {
+  return [...joints].sort((a, b) => depths[a] - depths[b] || a - b);
+}
+
 /** One character stepped by Tassel: what both public classes drive. */
 class Driver {
   constructor(tassel, ptr, gltf, options) {
@@ -130,24 +255,13 @@ class Driver {
     this.syncRotation = options.syncRotation ?? false;
     this.lastError = null;
     this.mode = tassel.string(x.tassel_mode(ptr));
-    const n = x.tassel_joint_count(ptr);
+    const { n, depths } = jointTable(tassel, ptr);
     this.count = n;
-    this.names = [];
-    this.parents = new Int32Array(n);
-    for (let j = 0; j < n; j++) {
-      this.names.push(tassel.string(x.tassel_joint_name(ptr, j)));
-      this.parents[j] = x.tassel_joint_parent(ptr, j);
-    }
     this.objects = nodeObjects(gltf, n);
-    // The joints Tassel writes (size_t is 32 bits in wasm32), parents before children.
-    const simCount = x.tassel_simulated_joint_count(ptr);
-    const sim = tassel.copyIn(new Uint8Array(Math.max(simCount, 1) * 4));
-    if (x.tassel_simulated_joints(ptr, sim[0], simCount) !== 0) throw tassel.error('simulated joints');
-    const written = Array.from(new Uint32Array(tassel.memory.buffer, sim[0], simCount));
-    tassel.free(sim);
-    const depth = (j) => (this.parents[j] < 0 ? 0 : 1 + depth(this.parents[j]));
-    written.sort((a, b) => depth(a) - depth(b) || a - b);
-    this.written = Int32Array.from(written.filter((j) => this.objects[j] !== null));
+    const simulated = indices(tassel, x.tassel_simulated_joint_count(ptr), (p, c) => x.tassel_simulated_joints(ptr, p, c), 'simulated joints');
+    this.written = Int32Array.from(parentsFirst(simulated.filter((j) => this.objects[j] !== null), depths));
+    this.all = new BoneParts(this.objects, Array.from({ length: n }, (_, j) => j));
+    this.out = new BoneParts(this.objects, Array.from(this.written));
     this.isWritten = new Uint8Array(n);
     for (const j of this.written) this.isWritten[j] = 1;
     // Transforms cross in one buffer of the module's memory: the root, then every joint.
@@ -169,11 +283,7 @@ class Driver {
 
   /** The bones' current local transforms become their animated pose. */
   capture() {
-    const a = this.animated;
-    for (let j = 0; j < this.count; j++) {
-      const o = this.objects[j];
-      if (o) readObject(o, a, j * FLOATS);
-    }
+    for (let j = 0; j < this.count; j++) this.all.read(j, this.animated, j * FLOATS);
     this.hasWritten = false;
   }
 
@@ -198,10 +308,8 @@ class Driver {
   /** The written bones go back to their animated pose and every solver starts again from
    *  it on the next update (three-vrm's reset). */
   reset() {
-    const a = this.animated;
-    for (const j of this.written) {
-      const o = this.objects[j];
-      setLocal(o, a, j * FLOATS, this.syncRotation);
+    for (let k = 0; k < this.written.length; k++) {
+      this.out.write(k, this.animated, this.written[k] * FLOATS, this.syncRotation);
     }
     this.hasWritten = false;
     this.tassel.x.tassel_reset(this.ptr);
@@ -216,41 +324,43 @@ class Driver {
     const locals = this.locals();
     const a = this.animated;
     const wrote = this.wrote;
+    const all = this.all;
+    const isWritten = this.isWritten;
     // The character's world transform: the scene's, refreshed (as three-vrm refreshes
     // what it reads).
     this.scene.updateWorldMatrix(true, false);
-    decompose(this.scene.matrixWorld, this.rootView);
+    decompose(this.scene.matrixWorld, this.rootView, 0);
+    const check = this.hasWritten;
     for (let j = 0; j < this.count; j++) {
-      const o = this.objects[j];
       const at = j * FLOATS;
-      if (o !== null && !(this.hasWritten && this.isWritten[j] === 1 && holds(o, wrote, at))) {
-        readObject(o, a, at);
-      }
+      if (!(check && isWritten[j] === 1 && all.holds(j, wrote, at))) all.read(j, a, at);
     }
     locals.set(a);
     if (x.tassel_frame(this.ptr, this.rootPtr, this.localsPtr, this.localsPtr, this.floats, delta) !== 0) {
-      const message = this.tassel.string(x.tassel_last_error());
-      if (message !== this.lastError) {
-        this.lastError = message;
-        if (this.onError) this.onError(message);
-        else console.warn(`tassel-three: ${message} (the bones keep their animated pose)`);
-      }
+      this.failed(this.tassel.string(x.tassel_last_error()));
       return false;
     }
     this.lastError = null;
     const out = this.locals();
     const written = this.written;
-    const objects = this.objects;
+    const parts = this.out;
     const syncRotation = this.syncRotation;
-    for (let w = 0; w < written.length; w++) {
-      const j = written[w];
-      const o = objects[j];
-      const at = j * FLOATS;
-      for (let k = 0; k < FLOATS; k++) wrote[at + k] = out[at + k];
-      setLocal(o, out, at, syncRotation);
+    for (let k = 0; k < written.length; k++) {
+      const at = written[k] * FLOATS;
+      for (let i = 0; i < FLOATS; i++) wrote[at + i] = out[at + i];
+      parts.write(k, out, at, syncRotation);
     }
     this.hasWritten = true;
     return true;
+  }
+
+  /** Reports a failed update's message (once until an update steps again). */
+  failed(message) {
+    if (message !== this.lastError) {
+      this.lastError = message;
+      if (this.onError) this.onError(message);
+      else console.warn(`tassel-three: ${message} (the bones keep their animated pose)`);
+    }
   }
 
   dispose() {
@@ -262,74 +372,15 @@ class Driver {
   }
 }
 
-function readObject(o, out, at) {
-  const p = o.position, q = o.quaternion, s = o.scale;
-  out[at] = p.x; out[at + 1] = p.y; out[at + 2] = p.z;
-  out[at + 3] = q.x; out[at + 4] = q.y; out[at + 5] = q.z; out[at + 6] = q.w;
-  out[at + 7] = s.x; out[at + 8] = s.y; out[at + 9] = s.z;
-}
-
-/** Writes bone `o`'s local transform from `v[at..at + 10]` and refreshes its `matrix` and
- *  `matrixWorld` (from its parent's), as three-vrm leaves its spring bones. The quaternion
- *  is written through its fields: three.js's setter would also recompute the Euler
- *  `rotation`, which costs more than the whole spring step; `syncRotation` asks for it. */
-function setLocal(o, v, at, syncRotation) {
-  const tx = v[at], ty = v[at + 1], tz = v[at + 2];
-  const x = v[at + 3], y = v[at + 4], z = v[at + 5], w = v[at + 6];
-  const sx = v[at + 7], sy = v[at + 8], sz = v[at + 9];
-  const p = o.position, q = o.quaternion, s = o.scale;
-  p.x = tx; p.y = ty; p.z = tz;
-  q._x = x; q._y = y; q._z = z; q._w = w;
-  s.x = sx; s.y = sy; s.z = sz;
-  if (syncRotation) o.rotation.setFromQuaternion(q, undefined, false);
-  // As Matrix4.compose.
-  const m = o.matrix.elements;
-  const x2 = x + x, y2 = y + y, z2 = z + z;
-  const xx = x * x2, xy = x * y2, xz = x * z2;
-  const yy = y * y2, yz = y * z2, zz = z * z2;
-  const wx = w * x2, wy = w * y2, wz = w * z2;
-  m[0] = (1 - (yy + zz)) * sx; m[1] = (xy + wz) * sx; m[2] = (xz - wy) * sx; m[3] = 0;
-  m[4] = (xy - wz) * sy; m[5] = (1 - (xx + zz)) * sy; m[6] = (yz + wx) * sy; m[7] = 0;
-  m[8] = (xz + wy) * sz; m[9] = (yz - wx) * sz; m[10] = (1 - (xx + yy)) * sz; m[11] = 0;
-  m[12] = tx; m[13] = ty; m[14] = tz; m[15] = 1;
-  const parent = o.parent;
-  const r = o.matrixWorld.elements;
-  if (parent === null) {
-    for (let i = 0; i < 16; i++) r[i] = m[i];
-    return;
-  }
-  // As Matrix4.multiplyMatrices(parent.matrixWorld, matrix), the last row (0 0 0 1).
-  const a = parent.matrixWorld.elements;
-  const a11 = a[0], a12 = a[4], a13 = a[8], a14 = a[12];
-  const a21 = a[1], a22 = a[5], a23 = a[9], a24 = a[13];
-  const a31 = a[2], a32 = a[6], a33 = a[10], a34 = a[14];
-  const a41 = a[3], a42 = a[7], a43 = a[11], a44 = a[15];
-  for (let c = 0; c < 16; c += 4) {
-    const b1 = m[c], b2 = m[c + 1], b3 = m[c + 2], b4 = m[c + 3];
-    r[c] = a11 * b1 + a12 * b2 + a13 * b3 + a14 * b4;
-    r[c + 1] = a21 * b1 + a22 * b2 + a23 * b3 + a24 * b4;
-    r[c + 2] = a31 * b1 + a32 * b2 + a33 * b3 + a34 * b4;
-    r[c + 3] = a41 * b1 + a42 * b2 + a43 * b3 + a44 * b4;
-  }
-}
-
-/** Whether `o` still holds what was written (as float32: what the module gave). */
-function holds(o, v, at) {
-  const p = o.position, q = o.quaternion, s = o.scale;
-  return Math.fround(q.x) === v[at + 3] && Math.fround(q.y) === v[at + 4] && Math.fround(q.z) === v[at + 5] && Math.fround(q.w) === v[at + 6]
-    && Math.fround(p.x) === v[at] && Math.fround(p.y) === v[at + 1] && Math.fround(p.z) === v[at + 2]
-    && Math.fround(s.x) === v[at + 7] && Math.fround(s.y) === v[at + 8] && Math.fround(s.z) === v[at + 9];
-}
-
 /** A Matrix4 (column-major, no shear) into 10 floats, without allocating. */
-function decompose(m, out) {
+function decompose(m, out, at) {
   const e = m.elements;
   let sx = Math.hypot(e[0], e[1], e[2]);
   const sy = Math.hypot(e[4], e[5], e[6]);
   const sz = Math.hypot(e[8], e[9], e[10]);
   const det = e[0] * (e[5] * e[10] - e[6] * e[9]) - e[4] * (e[1] * e[10] - e[2] * e[9]) + e[8] * (e[1] * e[6] - e[2] * e[5]);
   if (det < 0) sx = -sx;
-  out[0] = e[12]; out[1] = e[13]; out[2] = e[14];
+  out[at] = e[12]; out[at + 1] = e[13]; out[at + 2] = e[14];
   const ix = 1 / sx, iy = 1 / sy, iz = 1 / sz;
   const m11 = e[0] * ix, m12 = e[4] * iy, m13 = e[8] * iz;
   const m21 = e[1] * ix, m22 = e[5] * iy, m23 = e[9] * iz;
@@ -350,8 +401,8 @@ function decompose(m, out) {
     const s = 2.0 * Math.sqrt(1.0 + m33 - m11 - m22);
     qw = (m21 - m12) / s; qx = (m13 + m31) / s; qy = (m23 + m32) / s; qz = 0.25 * s;
   }
-  out[3] = qx; out[4] = qy; out[5] = qz; out[6] = qw;
-  out[7] = sx; out[8] = sy; out[9] = sz;
+  out[at + 3] = qx; out[at + 4] = qy; out[at + 5] = qz; out[at + 6] = qw;
+  out[at + 7] = sx; out[at + 8] = sy; out[at + 9] = sz;
 }
 
 /** What both public classes are: one character stepped by Tassel. */
@@ -403,5 +454,283 @@ export class TasselCharacter extends Stepped {
     const tassel = await loadTassel(options.wasm);
     const ptr = tassel.load(bytes, rigToml ?? null, options.mode ?? null);
     return new TasselCharacter(new Driver(tassel, ptr, gltf, options));
+  }
+}
+
+/** Many characters of one file stepped together: one WebAssembly call a frame for all of
+ *  them. A file whose only solver is VRM spring bones (or bone chains) runs on Tassel's
+ *  crowd path, the characters side by side in SIMD lanes; any other file one character
+ *  after another, still in one call. Each member gives the results its own
+ *  `TasselSpringBoneManager` / `TasselCharacter` would (reset before its first update),
+ *  bit for bit.
+ *
+ *    const crowd = await TasselCrowd.fromBytes(bytes, { mode: 'fixed' });
+ *    const a = crowd.add(gltfA), b = crowd.add(gltfB);   // GLTFLoader results of the file
+ *    vrmA.springBoneManager = a;   // optional: a member's update() does nothing, so
+ *                                  // vrm.update(delta) leaves the springs to the crowd
+ *    crowd.update(delta);          // every member, after their animation and vrm.update
+ */
+export class TasselCrowd {
+  /** `bytes`: the file (GLB, VRM or glTF with embedded buffers); options as
+   *  TasselSpringBoneManager.fromGLTF's, and `rigToml` for chains, springs, cloths and
+   *  ropes (needed for a file without VRM spring bones). */
+  static async fromBytes(bytes, options = {}) {
+    const tassel = await loadTassel(options.wasm);
+    const kind = tassel.load(bytes, options.rigToml ?? null, options.mode ?? null);
+    try {
+      return new TasselCrowd(tassel, kind, options);
+    } catch (e) {
+      tassel.x.tassel_character_free(kind);
+      throw e;
+    }
+  }
+
+  constructor(tassel, kind, options) {
+    const x = tassel.x;
+    this._tassel = tassel;
+    this._kind = kind;
+    this._onError = options.onError ?? null;
+    this._syncRotation = options.syncRotation ?? false;
+    const ptr = x.tassel_crowd_new(kind);
+    if (!ptr) throw tassel.error('the crowd was not made');
+    this._ptr = ptr;
+    this.mode = tassel.string(x.tassel_mode(kind));
+    /** How the members step: 'vrm' or 'chains' (side by side in SIMD lanes) or
+     *  'characters' (one after another). */
+    this.kind = tassel.string(x.tassel_crowd_kind(ptr));
+    const { n, depths } = jointTable(tassel, kind);
+    this._count = n;
+    this._read = indices(tassel, x.tassel_crowd_read_joint_count(ptr), (p, c) => x.tassel_crowd_read_joints(ptr, p, c), 'read joints');
+    this._written = indices(tassel, x.tassel_crowd_written_joint_count(ptr), (p, c) => x.tassel_crowd_written_joints(ptr, p, c), 'written joints');
+    // The written joints' places in the output, parents first.
+    const place = new Map(this._written.map((j, k) => [j, k]));
+    this._order = Int32Array.from(parentsFirst(this._written, depths), (j) => place.get(j));
+    // Each written joint's place among the read joints (-1: not read).
+    const readAt = new Map(this._read.map((j, r) => [j, r]));
+    this._writtenRead = Int32Array.from(this._written, (j) => readAt.get(j) ?? -1);
+    this._readWritten = Int32Array.from(this._read, (j) => place.get(j) ?? -1);
+    this._rest = new Float32Array(n * FLOATS);
+    const restBuf = tassel.copyIn(new Uint8Array(n * FLOATS * 4));
+    try {
+      if (x.tassel_rest_locals(kind, restBuf[0], n * FLOATS) !== 0) throw tassel.error('rest pose');
+      this._rest.set(new Float32Array(tassel.memory.buffer, restBuf[0], n * FLOATS));
+    } finally {
+      tassel.free(restBuf);
+    }
+    this._members = [];
+    this._capacity = 0;
+    this._buffers = null;
+    this._views = null;
+    this._held = new Uint8Array(0);
+    this.lastError = null;
+  }
+
+  /** Number of members. */
+  get size() { return this._members.length; }
+  /** The members, in crowd order. */
+  get members() { return [...this._members]; }
+
+  /** Adds a loaded copy of the file (its GLTFLoader result): its bones are mapped through
+   *  `gltf.parser.associations`, its root is `gltf.scene`. It starts from its pose on its
+   *  first update. */
+  add(gltf) {
+    if (!this._ptr) throw new Error('tassel-three: the crowd was disposed');
+    const objects = nodeObjects(gltf, this._count);
+    const i = this._tassel.x.tassel_crowd_add(this._ptr);
+    if (i < 0) throw this._tassel.error('add');
+    const member = new TasselCrowdMember(this, gltf.scene, objects, Number(i));
+    this._members.push(member);
+    this._reserve(this._members.length);
+    return member;
+  }
+
+  _reserve(count) {
+    if (count <= this._capacity) return;
+    const cap = Math.max(count, this._capacity * 2, 8);
+    const t = this._tassel;
+    const sizes = [cap * FLOATS, cap * this._read.length * FLOATS, cap * this._written.length * FLOATS];
+    const next = sizes.map((s) => t.copyIn(new Uint8Array(Math.max(s, 1) * 4)));
+    if (this._buffers) for (const b of this._buffers) t.free(b);
+    this._buffers = next;
+    this._capacity = cap;
+    this._views = null;
+    this._held = new Uint8Array(cap);
+  }
+
+  /** Float32Array views of the roots, inputs and outputs in the module's memory (made
+   *  again only when the memory grew or the buffers moved). */
+  _viewsNow() {
+    const buffer = this._tassel.memory.buffer;
+    if (!this._views || this._views[0].buffer !== buffer) {
+      this._views = this._buffers.map(([ptr, bytes]) => new Float32Array(buffer, ptr, bytes >> 2));
+    }
+    return this._views;
+  }
+
+  /** One frame of `delta` seconds for every member: reads each member's bones (the
+   *  joints the solvers read) and scene transform, steps all in one call, writes the
+   *  simulated bones. Returns false when some member's input was bad (NaN...): those keep
+   *  their animated pose (their `lastError` says why), the others stepped. */
+  update(delta) {
+    const members = this._members;
+    const count = members.length;
+    if (count === 0 || !this._ptr) return true;
+    const [roots, locals] = this._viewsNow();
+    const R = this._read.length * FLOATS;
+    const W = this._written.length * FLOATS;
+    const readWritten = this._readWritten;
+    for (let m = 0; m < count; m++) {
+      const member = members[m];
+      member._scene.updateWorldMatrix(true, false);
+      decompose(member._scene.matrixWorld, roots, m * FLOATS);
+      const parts = member._in;
+      const a = member._animated;
+      const wrote = member._wrote;
+      const check = member._hasWritten;
+      for (let r = 0, at = 0; at < R; r++, at += FLOATS) {
+        const k = readWritten[r];
+        if (!(check && k >= 0 && parts.holds(r, wrote, k * FLOATS))) parts.read(r, a, at);
+      }
+      locals.set(a, m * R);
+    }
+    const x = this._tassel.x;
+    const [rp, lp, op] = this._buffers;
+    const code = x.tassel_crowd_frame(this._ptr, rp[0], count * FLOATS, lp[0], count * R, op[0], count * W, delta);
+    const held = this._held;
+    held.fill(0);
+    if (code < 0) {
+      this._failed(this._tassel.string(x.tassel_last_error()), null);
+      return false;
+    }
+    if (code === 1) {
+      const list = indices(this._tassel, x.tassel_crowd_held_count(this._ptr), (p, c) => x.tassel_crowd_held(this._ptr, p, c), 'held');
+      this._failed(this._tassel.string(x.tassel_last_error()), list);
+      for (const i of list) held[i] = 1;
+    } else {
+      this.lastError = null;
+    }
+    // Made again if the frame grew the module's memory (which detaches the old views).
+    const out = this._viewsNow()[2];
+    const order = this._order;
+    const syncRotation = this._syncRotation;
+    for (let m = 0; m < count; m++) {
+      const member = members[m];
+      if (held[m] === 1) continue;
+      member.lastError = null;
+      const parts = member._out;
+      const wrote = member._wrote;
+      const base = m * W;
+      for (let w = 0; w < order.length; w++) {
+        const k = order[w];
+        const at = k * FLOATS;
+        for (let i = 0; i < FLOATS; i++) wrote[at + i] = out[base + at + i];
+        if (parts.p[k] !== null) parts.write(k, out, base + at, syncRotation);
+      }
+      member._hasWritten = true;
+    }
+    return code === 0;
+  }
+
+  _failed(message, list) {
+    const who = list === null ? this._members : list.map((i) => this._members[i]);
+    for (const m of who) m.lastError = message;
+    if (message !== this.lastError) {
+      this.lastError = message;
+      if (this._onError) this._onError(message);
+      else console.warn(`tassel-three: ${message} (those bones keep their animated pose)`);
+    }
+  }
+
+  _remove(member) {
+    const i = this._members.indexOf(member);
+    if (i < 0) return;
+    if (this._tassel.x.tassel_crowd_remove(this._ptr, i) !== 0) throw this._tassel.error('remove');
+    const last = this._members.pop();
+    if (last !== member) {
+      this._members[i] = last;
+      last._index = i;
+    }
+    member._crowd = null;
+  }
+
+  /** Frees the module's memory for the crowd (its members leave it). */
+  dispose() {
+    if (!this._ptr) return;
+    const x = this._tassel.x;
+    x.tassel_crowd_free(this._ptr);
+    x.tassel_character_free(this._kind);
+    if (this._buffers) for (const b of this._buffers) this._tassel.free(b);
+    for (const m of this._members) m._crowd = null;
+    this._members = [];
+    this._ptr = 0;
+  }
+}
+
+/** One character of a TasselCrowd. It can stand in for three-vrm's spring-bone manager
+ *  (`vrm.springBoneManager = member`): its `update` does nothing, the crowd's steps it. */
+export class TasselCrowdMember {
+  constructor(crowd, scene, objects, index) {
+    this._crowd = crowd;
+    this._scene = scene;
+    this._index = index;
+    this._objects = objects;
+    this._in = new BoneParts(objects, crowd._read);
+    this._out = new BoneParts(objects, crowd._written);
+    this._animated = new Float32Array(crowd._read.length * FLOATS);
+    crowd._read.forEach((j, r) => this._animated.set(crowd._rest.subarray(j * FLOATS, (j + 1) * FLOATS), r * FLOATS));
+    this._wrote = new Float32Array(crowd._written.length * FLOATS);
+    this._hasWritten = false;
+    this.lastError = null;
+    this._capture();
+  }
+
+  /** `fixed`, `spec`, `three-vrm` or `classic`. */
+  get mode() { return this._crowd?.mode ?? null; }
+  /** The three.js objects Tassel writes (the simulated bones). */
+  get bones() { return this._out.object.filter((o) => o !== null && o !== undefined); }
+  /** Its place in the crowd (changes when a member before it is removed). */
+  get index() { return this._index; }
+
+  _capture() {
+    for (let r = 0; r < this._in.p.length; r++) this._in.read(r, this._animated, r * FLOATS);
+    this._hasWritten = false;
+  }
+
+  /** Does nothing: the crowd's update steps every member (so that three-vrm's
+   *  `vrm.update(delta)` can run with this member as its spring-bone manager). */
+  update() { return true; }
+
+  /** The simulated bones go back to their animated pose and start again from it. */
+  reset() {
+    const crowd = this._crowd;
+    if (!crowd) return;
+    const wr = crowd._writtenRead;
+    for (let k = 0; k < wr.length; k++) {
+      if (this._out.p[k] === null) continue;
+      const j = crowd._written[k];
+      const [src, at] = wr[k] >= 0 ? [this._animated, wr[k] * FLOATS] : [crowd._rest, j * FLOATS];
+      this._out.write(k, src, at, crowd._syncRotation);
+    }
+    this._hasWritten = false;
+    crowd._tassel.x.tassel_crowd_reset(crowd._ptr, this._index);
+  }
+
+  /** The bones' current pose becomes the pose the simulation starts from. */
+  setInitState() {
+    const crowd = this._crowd;
+    if (!crowd) return;
+    this._capture();
+    crowd._tassel.x.tassel_crowd_reset(crowd._ptr, this._index);
+  }
+
+  /** The character was moved on purpose: start again at the new place, no whip. */
+  teleport() {
+    const crowd = this._crowd;
+    if (crowd) crowd._tassel.x.tassel_crowd_reset(crowd._ptr, this._index);
+  }
+
+  /** Leaves the crowd (the last member takes its place). */
+  dispose() {
+    this._crowd?._remove(this);
   }
 }

@@ -2,7 +2,7 @@
 //! chain on a plain glTF.
 //!
 //! ```text
-//! cargo run --release -p tassel-bevy --features gizmos,gltf --example fox
+//! cargo run --release -p tassel-bevy --features examples --example fox
 //! ```
 //! Reads `../shared/testdata/gltf/Fox.glb` (beside the clone) and
 //! `examples/rigs/fox.toml`. Keys: R resets the tail, G shows or hides the colliders.

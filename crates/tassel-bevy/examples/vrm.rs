@@ -1,7 +1,7 @@
 //! A VRM avatar swaying, its spring bones (0.x or 1.0) run by Tassel.
 //!
 //! ```text
-//! cargo run --release -p tassel-bevy --features gizmos,gltf --example vrm [-- path/to/avatar.vrm]
+//! cargo run --release -p tassel-bevy --features examples --example vrm [-- path/to/avatar.vrm]
 //! ```
 //! Without a path it opens `../shared/testdata/vrm/smoke_spring.vrm` (beside the clone).
 //! Keys: M switches fixed / spec stepping, R resets the springs, T teleports the avatar

@@ -1,4 +1,5 @@
-//! The C ABI over [`FlatCharacter`]: the functions of `include/tassel.h`.
+//! The C ABI over [`FlatCharacter`] and [`crate::FlatCrowd`]: the functions of
+//! `include/tassel.h`.
 //!
 //! Every function catches panics (none crosses the boundary: a panic is reported as an
 //! error) and takes NULL pointers, wrong lengths, misaligned or overlapping buffers and
@@ -10,6 +11,10 @@
 //! character pointer came from a load and was not freed; a character is used by one
 //! thread at a time.
 #![allow(unsafe_code)]
+
+mod crowd;
+
+pub use crowd::*;
 
 use crate::flat::{FlatCharacter, FLOATS_PER_JOINT};
 use std::cell::RefCell;
@@ -374,25 +379,36 @@ pub unsafe extern "C" fn tassel_simulated_joints(
     len: usize,
 ) -> i32 {
     guard("tassel_simulated_joints", -1, || {
-        // SAFETY: the caller's promise.
-        let ch = unsafe { character(c) }?;
-        let joints = ch.flat.simulated_joints();
-        if out.is_null() {
-            return Err("out is NULL".into());
-        }
-        if len != joints.len() {
-            return Err(format!(
-                "out holds {len} entries; the character simulates {} joints",
-                joints.len()
-            ));
-        }
-        if !(out as usize).is_multiple_of(std::mem::align_of::<usize>()) {
-            return Err("out is not aligned".into());
-        }
-        // SAFETY: non-NULL, aligned, `len` entries by the caller's promise.
-        unsafe { std::slice::from_raw_parts_mut(out, len) }.copy_from_slice(joints);
-        Ok(0)
+        // SAFETY: the caller's promises.
+        unsafe { copy_indices(character(c)?.flat.simulated_joints(), out, len, "joints") }
     })
+}
+
+/// `indices` into `out` (`len` entries, exactly as many).
+///
+/// # Safety
+/// `out` is NULL or points to `len` entries.
+unsafe fn copy_indices(
+    indices: &[usize],
+    out: *mut usize,
+    len: usize,
+    what: &str,
+) -> Result<i32, String> {
+    if out.is_null() {
+        return Err("out is NULL".into());
+    }
+    if len != indices.len() {
+        return Err(format!(
+            "out holds {len} entries; there are {} {what}",
+            indices.len()
+        ));
+    }
+    if !(out as usize).is_multiple_of(std::mem::align_of::<usize>()) {
+        return Err("out is not aligned".into());
+    }
+    // SAFETY: non-NULL, aligned, `len` entries by the caller's promise.
+    unsafe { std::slice::from_raw_parts_mut(out, len) }.copy_from_slice(indices);
+    Ok(0)
 }
 
 /// The mode the character steps in ("fixed", "spec", "three-vrm" or "classic"),

@@ -235,6 +235,11 @@ impl FlatCharacter {
         self.joint_to_node.get(joint).copied()
     }
 
+    /// The skeleton joint of node `node` (a node that exists).
+    pub(crate) fn joint_of(&self, node: usize) -> usize {
+        self.node_to_joint[node]
+    }
+
     fn check_len(&self, what: &str, len: usize) -> Result<(), String> {
         let want = self.joint_count() * FLOATS_PER_JOINT;
         if len == want {
@@ -262,12 +267,7 @@ impl FlatCharacter {
         // The simulation checks every input before it touches its state.
         self.sim
             .frame(&self.animated, read(root), dt)
-            .map_err(|e| match e {
-                tassel::Error::NonFinite(what) => {
-                    format!("non-finite value in {what}").replace("joint '", "joint (node) '")
-                }
-                e => e.to_string(),
-            })?;
+            .map_err(message)?;
         Ok(())
     }
 
@@ -283,7 +283,19 @@ impl FlatCharacter {
     }
 }
 
-fn read(v: &[f32]) -> Transform {
+/// A frame's error as the flat API reports it (a joint is named as a node, the flat API's
+/// joints being the file's nodes).
+pub(crate) fn message(e: tassel::Error) -> String {
+    match e {
+        tassel::Error::NonFinite(what) => {
+            format!("non-finite value in {what}").replace("joint '", "joint (node) '")
+        }
+        e => e.to_string(),
+    }
+}
+
+/// Ten floats (tx ty tz qx qy qz qw sx sy sz) as a transform.
+pub(crate) fn read(v: &[f32]) -> Transform {
     Transform::new(
         Vec3::new(v[0], v[1], v[2]),
         Quat::from_xyzw(v[3], v[4], v[5], v[6]),
@@ -291,7 +303,8 @@ fn read(v: &[f32]) -> Transform {
     )
 }
 
-fn write(t: &Transform, out: &mut [f32]) {
+/// A transform as ten floats.
+pub(crate) fn write(t: &Transform, out: &mut [f32]) {
     out[..3].copy_from_slice(&t.translation.to_array());
     out[3..7].copy_from_slice(&t.rotation.to_array());
     out[7..10].copy_from_slice(&t.scale.to_array());

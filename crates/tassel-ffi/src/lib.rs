@@ -16,6 +16,8 @@
 //! The same solver code runs here as in Rust and Bevy; no second implementation.
 
 pub mod abi;
+mod crowd;
 mod flat;
 
+pub use crowd::FlatCrowd;
 pub use flat::{parse_mode, FlatCharacter, FLOATS_PER_JOINT, MAX_RIG_BYTES};

@@ -5,7 +5,9 @@
 //! position per frame, composed in C or Python from the locals the ABI gives back; they
 //! must match `tassel simulate`'s world positions for the same file and motion to 1e-6 m.
 //! Both programs also check the ABI's promises on bad input (NULL, wrong lengths, NaN,
-//! overlapping buffers: errors with messages that change nothing).
+//! overlapping buffers: errors with messages that change nothing). The Python program also
+//! runs the crowd functions (`tassel_crowd_*`): three members against three characters of
+//! their own, bit for bit, and a member's NaN held.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -245,6 +247,12 @@ fn a_python_program_matches_tassel_simulate() {
         );
         let d = deviation(&simulate(file, mode), &parse("frame.py", &out));
         println!("{} {mode}: Python deviates {d:.2e} m", file.display());
+        let text = String::from_utf8_lossy(&out);
+        let crowd = text.lines().find_map(|l| l.strip_prefix("CROWD "));
+        assert!(
+            crowd.is_some_and(|n| n.parse::<usize>().is_ok_and(|n| n > 0)),
+            "frame.py compared no crowd output"
+        );
         assert!(d <= 1e-6, "{} {mode}: {d} m", file.display());
     }
 }
