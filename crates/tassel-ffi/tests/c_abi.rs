@@ -12,6 +12,9 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+mod common;
+use common::vrm_files;
+
 const FRAMES: usize = 90;
 const DT: &str = "0.0166666667";
 const AMP: &str = "0.3";
@@ -19,31 +22,6 @@ const FREQ: &str = "1.5";
 
 fn manifest() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
-
-fn vrm_files() -> Vec<PathBuf> {
-    let dir = manifest().join("../../../shared/testdata/vrm");
-    if !dir.is_dir() {
-        assert!(
-            std::env::var_os("TASSEL_REQUIRE_TESTDATA").is_none(),
-            "../shared/testdata is missing and TASSEL_REQUIRE_TESTDATA is set"
-        );
-        println!("SKIPPED: ../shared/testdata/vrm is missing (CI has shared/ beside the clone)");
-        return Vec::new();
-    }
-    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "vrm"))
-        .collect();
-    files.sort();
-    assert!(
-        files.len() >= 5,
-        "{} VRM files in {}",
-        files.len(),
-        dir.display()
-    );
-    files
 }
 
 /// The folder of this build's artifacts (`target/<profile>`): the test binary is in its

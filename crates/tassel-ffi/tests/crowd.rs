@@ -5,29 +5,12 @@
 //! character (springs, cloth, rope: one simulation a character) — through hitches, a
 //! member's reset, a removal and a member's bad frame (held, the others unchanged).
 
-use std::path::PathBuf;
+mod common;
+
+use common::vrm_files;
 use tassel_ffi::{FlatCharacter, FlatCrowd, FLOATS_PER_JOINT};
 
 const F: usize = FLOATS_PER_JOINT;
-
-fn vrm_files() -> Vec<PathBuf> {
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/testdata/vrm");
-    if !dir.is_dir() {
-        assert!(
-            std::env::var_os("TASSEL_REQUIRE_TESTDATA").is_none(),
-            "../shared/testdata is missing and TASSEL_REQUIRE_TESTDATA is set"
-        );
-        println!("SKIPPED: ../shared/testdata/vrm is missing (CI has shared/ beside the clone)");
-        return Vec::new();
-    }
-    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "vrm"))
-        .collect();
-    files.sort();
-    files
-}
 
 /// The built-in character as a GLB and its rig file, with only the solvers `keep` lists.
 fn builtin(keep: &[&str]) -> (Vec<u8>, String) {

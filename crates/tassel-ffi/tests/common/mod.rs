@@ -1,0 +1,30 @@
+//! What the tests of the C ABI and the crowd share.
+
+use std::path::PathBuf;
+
+/// The VRM files of `../shared/testdata/vrm`, sorted (at least five); empty, with a line
+/// saying it was skipped, when the folder is missing outside CI.
+pub fn vrm_files() -> Vec<PathBuf> {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/testdata/vrm");
+    if !dir.is_dir() {
+        assert!(
+            std::env::var_os("TASSEL_REQUIRE_TESTDATA").is_none(),
+            "../shared/testdata is missing and TASSEL_REQUIRE_TESTDATA is set"
+        );
+        println!("SKIPPED: ../shared/testdata/vrm is missing (CI has shared/ beside the clone)");
+        return Vec::new();
+    }
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "vrm"))
+        .collect();
+    files.sort();
+    assert!(
+        files.len() >= 5,
+        "{} VRM files in {}",
+        files.len(),
+        dir.display()
+    );
+    files
+}
