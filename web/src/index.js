@@ -227,7 +227,7 @@ function indices(tassel, count, fill, what) {
   }
 }
 
-/** A loaded character's joints (the file's nodes): count, parents and depths. */
+/** A loaded character's joints (the file's nodes): their count and depths. */
 function jointTable(tassel, ptr) {
   const x = tassel.x;
   const n = x.tassel_joint_count(ptr);
@@ -235,7 +235,7 @@ function jointTable(tassel, ptr) {
   for (let j = 0; j < n; j++) parents[j] = x.tassel_joint_parent(ptr, j);
   const depth = (j) => (parents[j] < 0 ? 0 : 1 + depth(parents[j]));
   const depths = Int32Array.from(parents, (_, j) => depth(j));
-  return { n, parents, depths };
+  return { n, depths };
 }
 
 /** Joints in the order they are written: parents before children (a child's world matrix

@@ -122,6 +122,13 @@ fn check_ptr(p: *const f32, len: usize, what: &str) -> Result<(), String> {
     Ok(())
 }
 
+/// Whether the `a_len` floats at `a` and the `b_len` floats at `b` share memory.
+fn overlaps(a: *const f32, a_len: usize, b: *const f32, b_len: usize) -> bool {
+    let bytes = |n: usize| n * std::mem::size_of::<f32>();
+    let (a, b) = (a as usize, b as usize);
+    a_len > 0 && b_len > 0 && a < b + bytes(b_len) && b < a + bytes(a_len)
+}
+
 fn new_character(flat: FlatCharacter) -> *mut TasselCharacter {
     let names = (0..flat.joint_count())
         .map(|j| {
@@ -311,9 +318,7 @@ pub unsafe extern "C" fn tassel_frame(
             } else {
                 let input = floats(locals_in, len, "locals_in")?;
                 check_ptr(locals_out, len, "locals_out")?;
-                let (a, b) = (locals_in as usize, locals_out as usize);
-                let bytes = len * std::mem::size_of::<f32>();
-                if a < b + bytes && b < a + bytes {
+                if overlaps(locals_in, len, locals_out, len) {
                     return Err("locals_in and locals_out overlap without being the same \
                                 buffer"
                         .into());

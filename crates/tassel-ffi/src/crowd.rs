@@ -320,18 +320,12 @@ impl FlatCrowd {
             }
         };
         if failed {
-            let held: Vec<(usize, String)> = match &self.run {
-                Run::Vrm(c) => c
-                    .held()
-                    .map(|(i, e)| (i, crate::flat::message(e.clone())))
-                    .collect(),
-                Run::Chains(c) => c
-                    .held()
-                    .map(|(i, e)| (i, crate::flat::message(e.clone())))
-                    .collect(),
-                Run::Characters(_) => Vec::new(),
-            };
-            self.held = held;
+            let message = |(i, e): (usize, &tassel::Error)| (i, crate::flat::message(e.clone()));
+            match &self.run {
+                Run::Vrm(c) => self.held.extend(c.held().map(message)),
+                Run::Chains(c) => self.held.extend(c.held().map(message)),
+                Run::Characters(_) => {}
+            }
         }
         self.write_out(out);
         Ok(self.held.is_empty())

@@ -1,7 +1,8 @@
 //! The C ABI over [`FlatCrowd`]: many characters of one kind, one call a frame.
 
 use super::{
-    character, check_ptr, copy_indices, floats, floats_mut, guard, set_error, TasselCharacter,
+    character, check_ptr, copy_indices, floats, floats_mut, guard, overlaps, set_error,
+    TasselCharacter,
 };
 use crate::crowd::FlatCrowd;
 use std::ffi::{c_char, CStr};
@@ -203,11 +204,8 @@ pub unsafe extern "C" fn tassel_crowd_frame(
         unsafe {
             let cr = crowd_mut(c)?;
             check_ptr(out, out_len, "out")?;
-            let bytes = |n: usize| n * std::mem::size_of::<f32>();
-            let (o, o_end) = (out as usize, out as usize + bytes(out_len));
             for (p, n, what) in [(roots, roots_len, "roots"), (locals, locals_len, "locals")] {
-                let (a, a_end) = (p as usize, p as usize + bytes(n));
-                if !p.is_null() && a < o_end && o < a_end && n > 0 && out_len > 0 {
+                if !p.is_null() && overlaps(p, n, out, out_len) {
                     return Err(format!("out overlaps {what}"));
                 }
             }
