@@ -130,6 +130,47 @@ fn simulate_builtin_follows_the_contract() {
 }
 
 #[test]
+fn simulate_builtin_with_the_skirt_of_chains_and_constraints() {
+    let d = tmp("skirt-chains");
+    let out_file = d.join("s.json");
+    let rig = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/rigs/skirt-chains.toml");
+    let out = simulate(
+        &[
+            "--builtin",
+            "--rig",
+            rig.to_str().unwrap(),
+            "--motion",
+            "sin",
+            "--frames",
+            "60",
+        ],
+        &out_file,
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let doc: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(&out_file).unwrap()).unwrap();
+    let joints = doc["joints"].as_array().unwrap();
+    // Every skirt bone but the columns' roots (and their rotating roots) is simulated.
+    let skirt = joints
+        .iter()
+        .filter(|j| j["name"].as_str().unwrap().starts_with("skirt_"))
+        .count();
+    assert_eq!(skirt, 32, "{joints:?}");
+    let last = doc["samples"].as_array().unwrap().last().unwrap();
+    let finite = last["world_pos"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .flat_map(|p| p.as_array().unwrap())
+        .all(|v| v.as_f64().is_some_and(f64::is_finite));
+    assert!(finite);
+}
+
+#[test]
 fn simulate_gltf_with_rig() {
     let Some(fox) = testdata("gltf/Fox.glb") else {
         return;
@@ -211,6 +252,11 @@ fn bad_input_fails_cleanly() {
         "[[chain]]\nname = \"p\"\nroot = \"ponytail_0\"\nstiffness = nan\n",
     );
     assert_fails(&["--builtin", "--rig", &nan], &out, "stiffness");
+    let itself = rig(
+        "itself.toml",
+        "[[chain]]\nname = \"p\"\nroot = \"ponytail_0\"\n[[bone_constraint]]\nbone1 = \"ponytail_2\"\nbone2 = \"ponytail_2\"\n",
+    );
+    assert_fails(&["--builtin", "--rig", &itself], &out, "bone_constraint #1");
     assert_fails(&["--builtin", "--dt", "1000"], &out, "--dt");
     assert_fails(&["--builtin", "--dt", "NaN"], &out, "--dt");
     if let Some(fox) = testdata("gltf/Fox.glb") {

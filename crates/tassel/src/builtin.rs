@@ -262,6 +262,7 @@ fn rig() -> RigSettings {
         springs,
         cloths,
         ropes,
+        ..Default::default()
     }
 }
 

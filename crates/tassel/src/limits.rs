@@ -41,3 +41,11 @@ pub const MAX_COLLIDER_PAIRS: usize = 1 << 22;
 
 /// The most constraint iterations a cloth or a rope's particle world runs per step.
 pub const MAX_ITERATIONS: u32 = 1_000;
+
+/// The most bone constraints (`[[bone_constraint]]` pairs after patterns, dummy tips'
+/// included) one rig may compile to.
+pub const MAX_BONE_CONSTRAINTS: usize = 1 << 16;
+
+/// The most bone-constraint solves (constraints × iterations before and after collision)
+/// a character's chains run per step.
+pub const MAX_CONSTRAINT_SOLVES: usize = 1 << 20;

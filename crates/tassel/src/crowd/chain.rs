@@ -74,6 +74,13 @@ impl ChainCrowd {
                 got: rig.joint_count(),
             });
         }
+        if rig.has_bone_constraints() {
+            return Err(Error::InvalidParameter(
+                "a chain crowd cannot step bone constraints (their chains step in groups): \
+                 run such characters through CharacterSim"
+                    .into(),
+            ));
+        }
         let shapes = rig
             .colliders
             .iter()

@@ -2,7 +2,9 @@
 //! docs/rig.md).
 
 use crate::collide::{PlacedCollider, Shape};
-use crate::dynamics::chain::ChainSettings;
+use crate::dynamics::chain::{
+    BoneConstraintOptions, BoneConstraintSettings, ChainSettings, Compliance,
+};
 use crate::dynamics::cloth::ClothSettings;
 use crate::dynamics::rope::RopeSettings;
 use crate::dynamics::spring::SpringSettings;
@@ -75,9 +77,25 @@ impl CompiledCollider {
 }
 
 /// Everything a rig file holds.
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RigSettings {
+    /// The compliance of `[[bone_constraint]]` entries without their own (KawaiiPhysics'
+    /// `BoneConstraintGlobalComplianceType`; default `"leather"`).
+    #[serde(default)]
+    pub bone_constraint_global_compliance_type: Compliance,
+    /// Bone-constraint solver passes before each step's collision pass (KawaiiPhysics
+    /// 1.21's `BoneConstraintIterationCountBeforeCollision`; default 0, as 1.20 runs).
+    #[serde(default)]
+    pub bone_constraint_iteration_count_before_collision: u32,
+    /// Bone-constraint solver passes after each step's collision pass
+    /// (`BoneConstraintIterationCountAfterCollision`; default 1).
+    #[serde(default = "one")]
+    pub bone_constraint_iteration_count_after_collision: u32,
+    /// A constraint whose two bones both end in a dummy tip (`dummy_bone_length`) also
+    /// joins the tips (`bAutoAddChildDummyBoneConstraint`; default true).
+    #[serde(default = "yes")]
+    pub auto_add_child_dummy_bone_constraint: bool,
     /// Bone chains (`[[chain]]` tables).
     #[serde(default, rename = "chain")]
     pub chains: Vec<ChainSettings>,
@@ -93,6 +111,39 @@ pub struct RigSettings {
     /// Ropes on bones driven by the particle world (`[[rope]]` tables).
     #[serde(default, rename = "rope")]
     pub ropes: Vec<RopeSettings>,
+    /// Distance constraints between simulated chain bones (`[[bone_constraint]]` tables;
+    /// KawaiiPhysics' bone constraints).
+    #[serde(
+        default,
+        rename = "bone_constraint",
+        skip_serializing_if = "Vec::is_empty"
+    )]
+    pub bone_constraints: Vec<BoneConstraintSettings>,
+}
+
+fn one() -> u32 {
+    1
+}
+
+fn yes() -> bool {
+    true
+}
+
+impl Default for RigSettings {
+    fn default() -> Self {
+        Self {
+            bone_constraint_global_compliance_type: Compliance::default(),
+            bone_constraint_iteration_count_before_collision: 0,
+            bone_constraint_iteration_count_after_collision: 1,
+            auto_add_child_dummy_bone_constraint: true,
+            chains: Vec::new(),
+            colliders: Vec::new(),
+            springs: Vec::new(),
+            cloths: Vec::new(),
+            ropes: Vec::new(),
+            bone_constraints: Vec::new(),
+        }
+    }
 }
 
 impl RigSettings {
@@ -163,6 +214,28 @@ impl RigSettings {
         for s in &self.springs {
             s.validate()?;
         }
+        self.bone_constraint_global_compliance_type
+            .validate("bone_constraint_global_compliance_type")?;
+        for (key, n) in [
+            (
+                "bone_constraint_iteration_count_before_collision",
+                self.bone_constraint_iteration_count_before_collision,
+            ),
+            (
+                "bone_constraint_iteration_count_after_collision",
+                self.bone_constraint_iteration_count_after_collision,
+            ),
+        ] {
+            if n > crate::limits::MAX_ITERATIONS {
+                return Err(Error::InvalidParameter(format!(
+                    "{key} = {n} is more than the limit of {}",
+                    crate::limits::MAX_ITERATIONS
+                )));
+            }
+        }
+        for (i, c) in self.bone_constraints.iter().enumerate() {
+            c.validate(i + 1)?;
+        }
         for r in &self.ropes {
             r.validate()?;
             known(&format!("rope '{}'", r.name), &r.colliders)?;
@@ -179,6 +252,16 @@ impl RigSettings {
             known(&format!("cloth '{}'", c.name), &c.colliders)?;
         }
         Ok(())
+    }
+
+    /// The rig-wide bone-constraint settings.
+    pub fn bone_constraint_options(&self) -> BoneConstraintOptions {
+        BoneConstraintOptions {
+            global_compliance: self.bone_constraint_global_compliance_type,
+            iterations_before_collision: self.bone_constraint_iteration_count_before_collision,
+            iterations_after_collision: self.bone_constraint_iteration_count_after_collision,
+            auto_add_child_dummy: self.auto_add_child_dummy_bone_constraint,
+        }
     }
 
     /// Indices into `colliders` of the named colliders, in the order named (all of them

@@ -1,5 +1,6 @@
 //! Compiling rig settings against a skeleton into flat, structure-of-arrays point data.
 
+use super::constraint::{self, Constraints, PointTable};
 use super::settings::ChainSettings;
 use crate::dynamics::{CompiledCollider, RigSettings};
 use crate::error::{Error, Result};
@@ -57,6 +58,8 @@ pub struct ChainRig {
     pub(crate) scalar_rotators: Vec<u32>,
     /// Per chain: stepped in a lane group (with the lanes on).
     pub(crate) chain_in_lanes: Vec<bool>,
+    /// Bone constraints and the chain groups they join.
+    pub(crate) constraints: Constraints,
     pub(crate) joint_count: usize,
 }
 
@@ -106,6 +109,7 @@ impl ChainRig {
             lane_groups: Vec::new(),
             scalar_rotators: Vec::new(),
             chain_in_lanes: Vec::new(),
+            constraints: Constraints::default(),
             joint_count: skeleton.len(),
         };
         out.colliders = CompiledCollider::compile_all(skeleton, rig);
@@ -244,6 +248,7 @@ impl ChainRig {
             out.rotators
                 .push((j, p, s..out.rotator_children.len() as u32));
         }
+        out.constraints = out.compile_constraints(skeleton, rig, &rest.models)?;
         let parents: Vec<Option<usize>> = (0..skeleton.len()).map(|j| skeleton.parent(j)).collect();
         out.lane_groups = crate::dynamics::chain::lanes::twins::plan(&parents, &out);
         out.chain_in_lanes = vec![false; out.chains.len()];
@@ -266,6 +271,64 @@ impl ChainRig {
             .filter(|&r| !rotator_in_lanes[r as usize])
             .collect();
         Ok(out)
+    }
+
+    /// The rig's bone constraints resolved against its points (rest lengths from the
+    /// skeleton's rest pose `models`).
+    fn compile_constraints(
+        &self,
+        skeleton: &Skeleton,
+        rig: &RigSettings,
+        models: &[crate::math::Transform],
+    ) -> Result<Constraints> {
+        let n = self.point_count();
+        let mut rest = vec![glam::Vec3::ZERO; n];
+        if !rig.bone_constraints.is_empty() {
+            let mut normals = vec![glam::Vec3::Y; n];
+            let mut placed = vec![
+                crate::collide::PlacedCollider {
+                    shape: crate::collide::Shape::Plane,
+                    transform: crate::math::Transform::IDENTITY,
+                };
+                self.colliders.len()
+            ];
+            super::job::gather_targets(
+                skeleton,
+                self,
+                models,
+                &mut rest,
+                &mut normals,
+                &mut placed,
+            );
+        }
+        let table = PointTable {
+            joint: &self.joint,
+            parent: &self.parent,
+            chain_of: &self.chain_of,
+            rest: &rest,
+        };
+        constraint::compile(
+            skeleton,
+            &rig.bone_constraints,
+            &rig.bone_constraint_options(),
+            &table,
+            &self.chains,
+        )
+    }
+
+    /// Whether any bone constraint joins this rig's chains (then its chains with
+    /// constraints step per character, not in a [`crate::crowd::ChainCrowd`]'s lanes).
+    pub fn has_bone_constraints(&self) -> bool {
+        !self.constraints.list.is_empty()
+    }
+
+    /// The chain group chain `ci` steps with, if bone constraints join it to others.
+    pub(crate) fn group_of(&self, ci: usize) -> Option<usize> {
+        self.constraints
+            .group_of
+            .get(ci)
+            .filter(|&&g| g != u32::MAX)
+            .map(|&g| g as usize)
     }
 
     /// Number of simulated points (chain roots and virtual tips included).

@@ -1,8 +1,9 @@
 //! Per-character chain state and the frame job.
 
 use super::compile::{ChainRig, NONE, VIRTUAL};
+use super::constraint::ChainGroup;
 use super::settings::TimeMode;
-use super::step::{step_chain, StepInput};
+use super::step::{step_chain, step_group, StepInput};
 use crate::collide::{NearSet, PlacedCollider};
 use crate::controller::Level;
 use crate::dynamics::chain::lanes::twins::{ChainLanes, LaneFrame, ScalarChains};
@@ -59,6 +60,10 @@ pub struct ChainState {
     in_lanes: bool,
     /// Scratch of the lanes' write-back: each rotator row between its two passes.
     turned: Vec<crate::dynamics::chain::lanes::twins::TurnedRow>,
+    /// Scratch of a bone-constraint group's step: the constraints' Lagrange multipliers,
+    /// and per chain whether the world is near.
+    lambda: Vec<f32>,
+    world_near: Vec<bool>,
 }
 
 impl ChainState {
@@ -101,6 +106,8 @@ impl ChainState {
             lanes: rig.lane_groups.iter().map(ChainLanes::new).collect(),
             in_lanes: false,
             turned: Vec::with_capacity(rig.rotators.len()),
+            lambda: vec![0.0; rig.constraints.list.len()],
+            world_near: vec![false; c],
         }
     }
 
@@ -242,6 +249,7 @@ impl ChainJob<'_> {
             && state.accumulator.len() == self.rig.chains.len()
             && state.colliders.len() == self.rig.colliders.len()
             && state.lanes.len() == self.rig.lane_groups.len()
+            && state.lambda.len() == self.rig.constraints.list.len()
             && state
                 .lanes
                 .iter()
@@ -304,9 +312,18 @@ impl ChainJob<'_> {
         let level = level.filter(|level| near_character(rig, state, &component, level));
         // A chain's frame reads nothing of another chain's: the twin chains in lanes run
         // after the others.
+        // Chains joined by bone constraints run as one group, when its first chain's turn
+        // comes.
         for ci in 0..rig.chains.len() {
-            if !(lanes && rig.in_lane_group(ci)) {
-                run_chain(rig, ci, state, &component, dt, level);
+            if lanes && rig.in_lane_group(ci) {
+                continue;
+            }
+            match rig.group_of(ci) {
+                None => run_chain(rig, ci, state, &component, dt, level),
+                Some(g) if rig.constraints.groups[g].chains[0] == ci => {
+                    run_group(rig, g, state, &component, dt, level)
+                }
+                Some(_) => {}
             }
         }
         if lanes {
@@ -411,7 +428,15 @@ pub(crate) fn place_colliders(
     }
 }
 
-fn reset_chain(rig: &ChainRig, ci: usize, state: &mut ChainState, component: &Transform) {
+/// Starts chain `ci` again from the animated pose, with its warm-up steps (`warmup`) or
+/// without (a group warms its chains up together).
+fn reset_chain(
+    rig: &ChainRig,
+    ci: usize,
+    state: &mut ChainState,
+    component: &Transform,
+    warmup: bool,
+) {
     for p in rig.chains[ci].points.clone() {
         state.pos[p] = state.targets[p];
         state.prev[p] = state.targets[p];
@@ -429,7 +454,7 @@ fn reset_chain(rig: &ChainRig, ci: usize, state: &mut ChainState, component: &Tr
     let h = 1.0 / s.target_framerate;
     state.dt_old[ci] = h;
     // Warm-up: settle in place with the current targets and no character motion.
-    for _ in 0..s.warmup_steps {
+    for _ in 0..if warmup { s.warmup_steps } else { 0 } {
         let input = StepInput {
             targets: &state.targets,
             normals: &state.normals,
@@ -555,18 +580,12 @@ fn run_chain(
     let s = &rig.chains[ci].settings;
     let points = rig.chains[ci].points.clone();
     // Teleport detection on the character's own motion this frame.
-    if !state.needs_reset[ci] {
-        let moved = (component.translation - state.prev_component.translation).length();
-        let turned = slerp_angle(state.prev_component.rotation, component.rotation).to_degrees();
-        if (s.teleport_distance > 0.0 && moved > s.teleport_distance)
-            || (s.teleport_rotation > 0.0 && turned > s.teleport_rotation)
-        {
-            state.needs_reset[ci] = true;
-            state.teleports += 1;
-        }
+    if !state.needs_reset[ci] && teleported(s, state, component) {
+        state.needs_reset[ci] = true;
+        state.teleports += 1;
     }
     if state.needs_reset[ci] {
-        reset_chain(rig, ci, state, component);
+        reset_chain(rig, ci, state, component, true);
     } else {
         match s.mode {
             TimeMode::Classic => {
@@ -617,8 +636,31 @@ fn run_chain(
     // Guard: never let a non-finite value out; start again from the pose instead.
     if points.clone().any(|p| !state.pos[p].is_finite()) {
         state.teleports += 1;
-        reset_chain(rig, ci, state, component);
+        reset_chain(rig, ci, state, component, true);
     }
+    output_chain(rig, ci, state, component, level);
+}
+
+/// Whether the character's motion this frame crosses chain settings `s`' teleport
+/// thresholds.
+fn teleported(s: &super::ChainSettings, state: &ChainState, component: &Transform) -> bool {
+    let moved = (component.translation - state.prev_component.translation).length();
+    let turned = slerp_angle(state.prev_component.rotation, component.rotation).to_degrees();
+    (s.teleport_distance > 0.0 && moved > s.teleport_distance)
+        || (s.teleport_rotation > 0.0 && turned > s.teleport_rotation)
+}
+
+/// Chain `ci`'s output: the animated pose plus the (interpolated) deviation, blended by
+/// alpha, with bone lengths restored from the root down and this frame's colliders kept.
+fn output_chain(
+    rig: &ChainRig,
+    ci: usize,
+    state: &mut ChainState,
+    component: &Transform,
+    level: Option<&Level>,
+) {
+    let s = &rig.chains[ci].settings;
+    let points = rig.chains[ci].points.clone();
     // Output: the animated pose plus the (interpolated) deviation, blended by alpha, with
     // bone lengths restored from the root down.
     let h = 1.0 / s.target_framerate;
@@ -694,10 +736,30 @@ pub(crate) fn slerp_angle(a: Quat, b: Quat) -> f32 {
     2.0 * d.acos()
 }
 
-fn run_fixed(rig: &ChainRig, ci: usize, state: &mut ChainState, dt: f32, level: Option<&Level>) {
-    let s = &rig.chains[ci].settings;
+/// Chain `ci`'s targets, normals and colliders for a fixed step ending at share `w` of
+/// the frame (a collider shared with another chain stepping at the same time is placed
+/// once).
+fn place_step(rig: &ChainRig, ci: usize, state: &mut ChainState, w: f32) {
+    for p in rig.chains[ci].points.clone() {
+        state.step_targets[p] = state.prev_targets[p].lerp(state.targets[p], w);
+        state.step_normals[p] = normalize_or(
+            state.prev_normals[p].lerp(state.normals[p], w),
+            state.normals[p],
+        );
+    }
+    for &c in &rig.chains[ci].colliders {
+        if state.step_placed_at[c].to_bits() != w.to_bits() {
+            state.step_colliders[c] = state.prev_colliders[c].lerp(&state.colliders[c], w);
+            state.step_bounds[c] = state.step_colliders[c].bound_sphere();
+            state.step_placed_at[c] = w;
+        }
+    }
+}
+
+/// The fixed steps of a frame of `dt` after `acc_old` seconds left over: how many, the
+/// time they cover, and the time a hitch dropped.
+fn fixed_steps(s: &super::ChainSettings, acc_old: f32, dt: f32) -> (u32, f32, f32) {
     let h = 1.0 / s.target_framerate;
-    let acc_old = state.accumulator[ci];
     let mut total = acc_old + dt;
     let mut steps = (total / h + 1e-4).floor() as u32;
     if steps > s.max_steps_per_frame {
@@ -705,30 +767,28 @@ fn run_fixed(rig: &ChainRig, ci: usize, state: &mut ChainState, dt: f32, level: 
         total -= (steps - s.max_steps_per_frame) as f32 * h;
         steps = s.max_steps_per_frame;
     }
-    let skipped = acc_old + dt - total;
+    (steps, total, acc_old + dt - total)
+}
+
+/// Where step `k` of a frame of `dt` ends between last frame (0) and this frame (1).
+fn step_end(k: u32, h: f32, acc_old: f32, skipped: f32, dt: f32) -> f32 {
+    let end = k as f32 * h - acc_old + skipped;
+    if dt > 0.0 {
+        (end / dt).clamp(0.0, 1.0)
+    } else {
+        1.0
+    }
+}
+
+fn run_fixed(rig: &ChainRig, ci: usize, state: &mut ChainState, dt: f32, level: Option<&Level>) {
+    let s = &rig.chains[ci].settings;
+    let h = 1.0 / s.target_framerate;
+    let acc_old = state.accumulator[ci];
+    let (steps, total, skipped) = fixed_steps(s, acc_old, dt);
     let points = rig.chains[ci].points.clone();
     for k in 1..=steps {
-        // Where this step ends between last frame (0) and this frame (1).
-        let end = k as f32 * h - acc_old + skipped;
-        let w = if dt > 0.0 {
-            (end / dt).clamp(0.0, 1.0)
-        } else {
-            1.0
-        };
-        for p in points.clone() {
-            state.step_targets[p] = state.prev_targets[p].lerp(state.targets[p], w);
-            state.step_normals[p] = normalize_or(
-                state.prev_normals[p].lerp(state.normals[p], w),
-                state.normals[p],
-            );
-        }
-        for &c in &rig.chains[ci].colliders {
-            if state.step_placed_at[c].to_bits() != w.to_bits() {
-                state.step_colliders[c] = state.prev_colliders[c].lerp(&state.colliders[c], w);
-                state.step_bounds[c] = state.step_colliders[c].bound_sphere();
-                state.step_placed_at[c] = w;
-            }
-        }
+        let w = step_end(k, h, acc_old, skipped, dt);
+        place_step(rig, ci, state, w);
         let comp_b = state.path.at(w);
         let (move_cs, rotate_cs) = motion_cs(&state.last_step_component[ci], &comp_b);
         let world = world_for(
@@ -769,6 +829,238 @@ fn run_fixed(rig: &ChainRig, ci: usize, state: &mut ChainState, dt: f32, level: 
         }
     }
     state.accumulator[ci] = (total - steps as f32 * h).max(0.0);
+}
+
+/// One frame of bone-constraint group `g`: its chains reset together, step together
+/// ([`step_group`]) and are written out one by one.
+fn run_group(
+    rig: &ChainRig,
+    g: usize,
+    state: &mut ChainState,
+    component: &Transform,
+    dt: f32,
+    level: Option<&Level>,
+) {
+    let group = &rig.constraints.groups[g];
+    let lead = group.chains[0];
+    let s = &rig.chains[lead].settings;
+    let mut reset = group.chains.iter().any(|&ci| state.needs_reset[ci]);
+    if !reset
+        && group
+            .chains
+            .iter()
+            .any(|&ci| teleported(&rig.chains[ci].settings, state, component))
+    {
+        state.teleports += 1;
+        reset = true;
+    }
+    if reset {
+        reset_group(rig, group, state, component);
+    } else {
+        match s.mode {
+            TimeMode::Classic => {
+                let dt = dt.min(s.max_delta_time);
+                if dt > 0.0 {
+                    let from = state.prev_component;
+                    for &ci in &group.chains {
+                        state.world_near[ci] =
+                            world_for(rig, ci, level, &state.pos, &state.targets, &from, component)
+                                .is_some();
+                    }
+                    let (move_cs, rotate_cs) = motion_cs(&from, component);
+                    let ChainState {
+                        pos,
+                        prev,
+                        rng,
+                        lambda,
+                        targets,
+                        normals,
+                        colliders,
+                        bounds,
+                        dt_old,
+                        world_near,
+                        ..
+                    } = &mut *state;
+                    let input_of = |ci: usize| {
+                        let s = &rig.chains[ci].settings;
+                        StepInput {
+                            targets,
+                            normals,
+                            colliders,
+                            bounds,
+                            move_cs,
+                            rotate_cs,
+                            gravity_cs: gravity_cs(s, component),
+                            wind_cs: wind_cs(s, component),
+                            dt,
+                            dt_old: dt_old[ci],
+                            fixed: false,
+                            world: level.filter(|_| world_near[ci]).map(|level| WorldContact {
+                                level,
+                                from,
+                                to: *component,
+                            }),
+                        }
+                    };
+                    step_group(rig, group, &input_of, pos, prev, rng, lambda);
+                    group.chains.iter().for_each(|&ci| dt_old[ci] = dt);
+                }
+                for &ci in &group.chains {
+                    for p in rig.chains[ci].points.clone() {
+                        state.dev[p] = state.pos[p] - state.targets[p];
+                        state.dev_before[p] = state.dev[p];
+                    }
+                }
+            }
+            TimeMode::Fixed => run_fixed_group(rig, group, state, dt, level),
+        }
+    }
+    // Guard: never let a non-finite value out; start again from the pose instead.
+    let bad = |ci: usize| {
+        rig.chains[ci]
+            .points
+            .clone()
+            .any(|p| !state.pos[p].is_finite())
+    };
+    if group.chains.iter().any(|&ci| bad(ci)) {
+        state.teleports += 1;
+        reset_group(rig, group, state, component);
+    }
+    for &ci in &group.chains {
+        output_chain(rig, ci, state, component, level);
+    }
+}
+
+/// Starts a group's chains again from the animated pose and warms them up together.
+fn reset_group(rig: &ChainRig, group: &ChainGroup, state: &mut ChainState, component: &Transform) {
+    for &ci in &group.chains {
+        reset_chain(rig, ci, state, component, false);
+    }
+    let s = &rig.chains[group.chains[0]].settings;
+    let h = 1.0 / s.target_framerate;
+    let fixed = s.mode == TimeMode::Fixed;
+    {
+        let ChainState {
+            pos,
+            prev,
+            rng,
+            lambda,
+            targets,
+            normals,
+            colliders,
+            bounds,
+            ..
+        } = &mut *state;
+        let input_of = |ci: usize| {
+            let s = &rig.chains[ci].settings;
+            StepInput {
+                targets,
+                normals,
+                colliders,
+                bounds,
+                move_cs: Vec3::ZERO,
+                rotate_cs: Quat::IDENTITY,
+                gravity_cs: gravity_cs(s, component),
+                wind_cs: wind_cs(s, component),
+                dt: h,
+                dt_old: h,
+                fixed,
+                world: None,
+            }
+        };
+        for _ in 0..s.warmup_steps {
+            step_group(rig, group, &input_of, pos, prev, rng, lambda);
+        }
+    }
+    for &ci in &group.chains {
+        for p in rig.chains[ci].points.clone() {
+            state.dev[p] = state.pos[p] - state.targets[p];
+            state.dev_before[p] = state.dev[p];
+        }
+    }
+}
+
+/// A fixed-mode frame of a group: its chains share one clock (the compile checks their
+/// rates agree), so every step places all their targets, then steps them together.
+fn run_fixed_group(
+    rig: &ChainRig,
+    group: &ChainGroup,
+    state: &mut ChainState,
+    dt: f32,
+    level: Option<&Level>,
+) {
+    let lead = group.chains[0];
+    let s = &rig.chains[lead].settings;
+    let h = 1.0 / s.target_framerate;
+    let acc_old = state.accumulator[lead];
+    let (steps, total, skipped) = fixed_steps(s, acc_old, dt);
+    for k in 1..=steps {
+        let w = step_end(k, h, acc_old, skipped, dt);
+        for &ci in &group.chains {
+            place_step(rig, ci, state, w);
+        }
+        let comp_b = state.path.at(w);
+        let from = state.last_step_component[lead];
+        for &ci in &group.chains {
+            state.world_near[ci] = world_for(
+                rig,
+                ci,
+                level,
+                &state.pos,
+                &state.step_targets,
+                &from,
+                &comp_b,
+            )
+            .is_some();
+        }
+        let (move_cs, rotate_cs) = motion_cs(&from, &comp_b);
+        {
+            let ChainState {
+                pos,
+                prev,
+                rng,
+                lambda,
+                step_targets,
+                step_normals,
+                step_colliders,
+                step_bounds,
+                world_near,
+                ..
+            } = &mut *state;
+            let input_of = |ci: usize| {
+                let s = &rig.chains[ci].settings;
+                StepInput {
+                    targets: step_targets,
+                    normals: step_normals,
+                    colliders: step_colliders,
+                    bounds: step_bounds,
+                    move_cs,
+                    rotate_cs,
+                    gravity_cs: gravity_cs(s, &comp_b),
+                    wind_cs: wind_cs(s, &comp_b),
+                    dt: h,
+                    dt_old: h,
+                    fixed: true,
+                    world: level.filter(|_| world_near[ci]).map(|level| WorldContact {
+                        level,
+                        from,
+                        to: comp_b,
+                    }),
+                }
+            };
+            step_group(rig, group, &input_of, pos, prev, rng, lambda);
+        }
+        for &ci in &group.chains {
+            state.last_step_component[ci] = comp_b;
+            for p in rig.chains[ci].points.clone() {
+                state.dev_before[p] = state.dev[p];
+                state.dev[p] = state.pos[p] - state.step_targets[p];
+            }
+        }
+    }
+    for &ci in &group.chains {
+        state.accumulator[ci] = (total - steps as f32 * h).max(0.0);
+    }
 }
 
 /// Turns each simulated parent toward its simulated children (mean direction), on top of

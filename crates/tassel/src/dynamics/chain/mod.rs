@@ -7,11 +7,13 @@
 //! skeleton; [`ChainState`] is the small per-character state; [`ChainJob`] runs one frame.
 
 pub(crate) mod compile;
+pub(crate) mod constraint;
 pub(crate) mod job;
 pub(crate) mod lanes;
 mod settings;
 pub(crate) mod step;
 
 pub use compile::{ChainRig, PointInfo};
+pub use constraint::{BoneConstraintOptions, BoneConstraintSettings, Compliance, CompliancePreset};
 pub use job::{ChainJob, ChainState};
 pub use settings::{ChainCurves, ChainSettings, ClassicGravity, PlanarAxis, TimeMode, Wind};

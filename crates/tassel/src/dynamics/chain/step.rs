@@ -1,6 +1,7 @@
 //! One solver step of one chain: the readable, per-point reference path.
 
 use super::compile::{ChainRig, NONE};
+use super::constraint::{solve, ChainGroup};
 use super::settings::{ChainSettings, ClassicGravity, PlanarAxis};
 use crate::collide::{NearSet, PlacedCollider};
 use crate::math::normalize_or;
@@ -34,7 +35,174 @@ pub(crate) struct StepInput<'a> {
     pub world: Option<crate::dynamics::world::WorldContact<'a>>,
 }
 
-/// Advances the points of chain `ci` by one step.
+/// What one step of a chain uses for every point.
+struct ChainStep {
+    exponent: f32,
+    gravity_step: Vec3,
+    wind_on: bool,
+}
+
+impl ChainStep {
+    fn of(s: &ChainSettings, input: &StepInput) -> Self {
+        Self {
+            exponent: s.target_framerate * input.dt,
+            gravity_step: gravity_step(s, input.gravity_cs, input.dt, input.fixed),
+            wind_on: s.wind.speed > 0.0 && input.wind_cs != Vec3::ZERO,
+        }
+    }
+}
+
+/// Where point `p` (parent `pp`) goes this step before any contact: Verlet velocity,
+/// damping, wind, the character's motion as inertia, gravity and the pull toward the
+/// animated pose relative to the simulated parent. Moves `prev[p]` to `pos[p]`.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+fn advance(
+    rig: &ChainRig,
+    s: &ChainSettings,
+    k: &ChainStep,
+    input: &StepInput,
+    p: usize,
+    pp: usize,
+    pos: &[Vec3],
+    prev: &mut [Vec3],
+    rng: &mut SplitMix64,
+) -> Vec3 {
+    let t = input.targets;
+    // Verlet velocity from the previous position, damped.
+    let mut velocity = if input.dt_old > 0.0 {
+        (pos[p] - prev[p]) / input.dt_old
+    } else {
+        Vec3::ZERO
+    };
+    prev[p] = pos[p];
+    velocity *= 1.0 - rig.damping[p];
+    if k.wind_on {
+        let gust = rng.range_f32(1.0 - s.wind.gust, 1.0 + s.wind.gust);
+        velocity += input.wind_cs * s.wind.speed * gust * s.target_framerate;
+    }
+    let mut x = pos[p] + velocity * input.dt;
+
+    // Inertia: follow the character's translation and rotation only partly.
+    x += input.move_cs * (1.0 - rig.wd_location[p]);
+    x += (input.rotate_cs * prev[p] - prev[p]) * (1.0 - rig.wd_rotation[p]);
+    x += k.gravity_step;
+
+    // Pull toward the animated pose, relative to the simulated parent.
+    let base = pos[pp] + (t[p] - t[pp]);
+    x += (base - x) * pull(rig.stiffness[p], k.exponent);
+    x
+}
+
+/// Point `p`'s contacts for one pass: the colliders near it and the world.
+struct Contact<'a> {
+    near: NearSet,
+    list: &'a [usize],
+    input: &'a StepInput<'a>,
+    from: Vec3,
+    r: f32,
+}
+
+impl<'a> Contact<'a> {
+    /// Broad phase: every point the colliders see below starts as `x` now or as a point
+    /// on the sphere of the bone's length about the parent (`restore`), and every step
+    /// starts at `prev[p]`; a collider that cannot touch their box gives any such point
+    /// back unchanged, so it is skipped while the point is still the one the pass began
+    /// with (once a nearer collider moved it, every later collider is asked).
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    fn of(
+        rig: &ChainRig,
+        list: &'a [usize],
+        input: &'a StepInput<'a>,
+        p: usize,
+        parent: Vec3,
+        length: f32,
+        x: Vec3,
+        from: Vec3,
+    ) -> Self {
+        let r = rig.radius[p];
+        let near = NearSet::of(
+            list,
+            input.bounds,
+            from.min(x).min(parent - length),
+            from.max(x).max(parent + length),
+            r,
+        );
+        Self {
+            near,
+            list,
+            input,
+            from,
+            r,
+        }
+    }
+
+    #[inline]
+    fn resolve(&self, x: Vec3) -> Vec3 {
+        let mut x = self
+            .near
+            .resolve(self.list, self.input.colliders, x, Some(self.from), self.r);
+        if let Some(world) = &self.input.world {
+            x = world.resolve(x, self.from, self.r);
+        }
+        x
+    }
+}
+
+/// Point `p`'s last word in a step: the cone limit, the planar constraint, the bone
+/// length about its parent's final place, and collisions settled against that length.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+fn finish(
+    rig: &ChainRig,
+    s: &ChainSettings,
+    input: &StepInput,
+    p: usize,
+    pp: usize,
+    mut x: Vec3,
+    pos: &[Vec3],
+    contact: &Contact,
+    collides: bool,
+) -> Vec3 {
+    let t = input.targets;
+    // Cone limit around the animated direction.
+    let anim_dir = t[p] - t[pp];
+    let limit = rig.limit_angle[p];
+    if limit > 0.0 {
+        x = cone_limit(x, pos[pp], anim_dir, limit);
+    }
+    if s.planar_constraint != PlanarAxis::None {
+        let n = input.normals[p];
+        x -= n * (x - pos[pp]).dot(n);
+    }
+
+    // Keep the bone length, then settle collisions against the length a few times;
+    // collisions get the last word.
+    let length = anim_dir.length();
+    let fallback = normalize_or(anim_dir, Vec3::Y);
+    let restore = |x: Vec3| pos[pp] + normalize_or(x - pos[pp], fallback) * length;
+    x = restore(x);
+    if collides {
+        let mut settled = false;
+        for _ in 0..3 {
+            let y = contact.resolve(x);
+            if y == x {
+                settled = true;
+                break;
+            }
+            x = restore(y);
+        }
+        if !settled {
+            x = contact.resolve(x);
+        }
+    }
+    x
+}
+
+/// Advances the points of chain `ci` by one step, point after point (KawaiiPhysics
+/// 1.10's order: each point integrated, collided, limited and put back at its length
+/// before the next).
 pub(crate) fn step_chain(
     rig: &ChainRig,
     ci: usize,
@@ -45,10 +213,9 @@ pub(crate) fn step_chain(
 ) {
     let chain = &rig.chains[ci];
     let s = &chain.settings;
-    let exponent = s.target_framerate * input.dt;
-    let gravity_step = gravity_step(s, input.gravity_cs, input.dt, input.fixed);
-    let wind_on = s.wind.speed > 0.0 && input.wind_cs != Vec3::ZERO;
+    let k = ChainStep::of(s, input);
     let t = input.targets;
+    let collides = !chain.colliders.is_empty() || input.world.is_some();
     for p in chain.points.clone() {
         let parent = rig.parent[p];
         if parent == NONE {
@@ -57,84 +224,118 @@ pub(crate) fn step_chain(
             continue;
         }
         let pp = parent as usize;
-
-        // Verlet velocity from the previous position, damped.
-        let mut velocity = if input.dt_old > 0.0 {
-            (pos[p] - prev[p]) / input.dt_old
-        } else {
-            Vec3::ZERO
-        };
-        prev[p] = pos[p];
-        velocity *= 1.0 - rig.damping[p];
-        if wind_on {
-            let gust = rng.range_f32(1.0 - s.wind.gust, 1.0 + s.wind.gust);
-            velocity += input.wind_cs * s.wind.speed * gust * s.target_framerate;
-        }
-        let mut x = pos[p] + velocity * input.dt;
-
-        // Inertia: follow the character's translation and rotation only partly.
-        x += input.move_cs * (1.0 - rig.wd_location[p]);
-        x += (input.rotate_cs * prev[p] - prev[p]) * (1.0 - rig.wd_rotation[p]);
-        x += gravity_step;
-
-        // Pull toward the animated pose, relative to the simulated parent.
-        let base = pos[pp] + (t[p] - t[pp]);
-        x += (base - x) * pull(rig.stiffness[p], exponent);
-
-        let r = rig.radius[p];
-        // Broad phase: every point the colliders see below starts as `x` now or as a point
-        // on the sphere of the bone's length about the parent (`restore`), and every step
-        // starts at `prev[p]`; a collider that cannot touch their box gives any such point
-        // back unchanged, so it is skipped while the point is still the one the pass began
-        // with (once a nearer collider moved it, every later collider is asked).
+        let x = advance(rig, s, &k, input, p, pp, pos, prev, rng);
         let length = (t[p] - t[pp]).length();
-        let near = NearSet::of(
-            &chain.colliders,
-            input.bounds,
-            prev[p].min(x).min(pos[pp] - length),
-            prev[p].max(x).max(pos[pp] + length),
-            r,
-        );
-        let collide = |x: Vec3| {
-            let mut x = near.resolve(&chain.colliders, input.colliders, x, Some(prev[p]), r);
-            if let Some(world) = &input.world {
-                x = world.resolve(x, prev[p], r);
-            }
-            x
-        };
-        x = collide(x);
+        let contact = Contact::of(rig, &chain.colliders, input, p, pos[pp], length, x, prev[p]);
+        let x = contact.resolve(x);
+        pos[p] = finish(rig, s, input, p, pp, x, pos, &contact, collides);
+    }
+}
 
-        // Cone limit around the animated direction.
-        let anim_dir = t[p] - t[pp];
-        let limit = rig.limit_angle[p];
-        if limit > 0.0 {
-            x = cone_limit(x, pos[pp], anim_dir, limit);
-        }
-        if s.planar_constraint != PlanarAxis::None {
-            let n = input.normals[p];
-            x -= n * (x - pos[pp]).dot(n);
-        }
-
-        // Keep the bone length, then settle collisions against the length a few times;
-        // collisions get the last word.
-        let fallback = normalize_or(anim_dir, Vec3::Y);
-        let restore = |x: Vec3| pos[pp] + normalize_or(x - pos[pp], fallback) * length;
-        x = restore(x);
-        if !chain.colliders.is_empty() || input.world.is_some() {
-            let mut settled = false;
-            for _ in 0..3 {
-                let y = collide(x);
-                if y == x {
-                    settled = true;
-                    break;
-                }
-                x = restore(y);
+/// Advances the chains of a bone-constraint group by one step in KawaiiPhysics 1.20's
+/// phase order: every point integrated; `before` constraint passes; every point
+/// collided; `after` passes; then every point limited and put back at its bone length
+/// (and settled against the colliders, Tassel's last word as in [`step_chain`]).
+/// `input_of(ci)` is chain `ci`'s step input; the constraints use the first chain's `dt`.
+pub(crate) fn step_group<'a>(
+    rig: &ChainRig,
+    group: &ChainGroup,
+    input_of: &dyn Fn(usize) -> StepInput<'a>,
+    pos: &mut [Vec3],
+    prev: &mut [Vec3],
+    rngs: &mut [SplitMix64],
+    lambda: &mut [f32],
+) {
+    for &ci in &group.chains {
+        let chain = &rig.chains[ci];
+        let input = input_of(ci);
+        let k = ChainStep::of(&chain.settings, &input);
+        for p in chain.points.clone() {
+            let parent = rig.parent[p];
+            if parent == NONE {
+                pos[p] = input.targets[p];
+                prev[p] = input.targets[p];
+                continue;
             }
-            if !settled {
-                x = collide(x);
-            }
+            pos[p] = advance(
+                rig,
+                &chain.settings,
+                &k,
+                &input,
+                p,
+                parent as usize,
+                pos,
+                prev,
+                &mut rngs[ci],
+            );
         }
-        pos[p] = x;
+    }
+    let dt = input_of(group.chains[0]).dt;
+    let list = &rig.constraints.list[group.constraints.clone()];
+    let lambda = &mut lambda[group.constraints.clone()];
+    solve(list, lambda, pos, dt, rig.constraints.before);
+    for &ci in &group.chains {
+        let chain = &rig.chains[ci];
+        if chain.colliders.is_empty() && input_of(ci).world.is_none() {
+            continue;
+        }
+        let input = input_of(ci);
+        let t = input.targets;
+        for p in chain.points.clone() {
+            let parent = rig.parent[p];
+            if parent == NONE {
+                continue;
+            }
+            let pp = parent as usize;
+            let length = (t[p] - t[pp]).length();
+            let contact = Contact::of(
+                rig,
+                &chain.colliders,
+                &input,
+                p,
+                pos[pp],
+                length,
+                pos[p],
+                prev[p],
+            );
+            pos[p] = contact.resolve(pos[p]);
+        }
+    }
+    solve(list, lambda, pos, dt, rig.constraints.after);
+    for &ci in &group.chains {
+        let chain = &rig.chains[ci];
+        let input = input_of(ci);
+        let t = input.targets;
+        let collides = !chain.colliders.is_empty() || input.world.is_some();
+        for p in chain.points.clone() {
+            let parent = rig.parent[p];
+            if parent == NONE {
+                continue;
+            }
+            let pp = parent as usize;
+            let length = (t[p] - t[pp]).length();
+            let contact = Contact::of(
+                rig,
+                &chain.colliders,
+                &input,
+                p,
+                pos[pp],
+                length,
+                pos[p],
+                prev[p],
+            );
+            pos[p] = finish(
+                rig,
+                &chain.settings,
+                &input,
+                p,
+                pp,
+                pos[p],
+                pos,
+                &contact,
+                collides,
+            );
+        }
     }
 }
 

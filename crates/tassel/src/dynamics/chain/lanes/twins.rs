@@ -90,7 +90,8 @@ pub(crate) fn plan(sk_parent: &[Option<usize>], rig: &ChainRig) -> Vec<ChainLane
     // Each key's group still open (fewer than LANES chains): one look-up per chain.
     let mut open: std::collections::HashMap<_, usize> = std::collections::HashMap::new();
     for ci in 0..rig.chains.len() {
-        if rig.chains[ci].settings.world_collision {
+        // Chains joined by bone constraints step with their group.
+        if rig.chains[ci].settings.world_collision || rig.group_of(ci).is_some() {
             continue;
         }
         let key = twin_key(rig, ci);
@@ -277,6 +278,7 @@ fn one_chain(rig: &ChainRig, ci: usize) -> ChainRig {
         limit_angle: slice(&rig.limit_angle),
         rotators: Vec::new(),
         rotator_children: Vec::new(),
+        constraints: Default::default(),
         lane_groups: Vec::new(),
         scalar_rotators: Vec::new(),
         chain_in_lanes: Vec::new(),
