@@ -74,10 +74,10 @@ impl ChainCrowd {
                 got: rig.joint_count(),
             });
         }
-        if rig.has_bone_constraints() {
+        if rig.has_bone_constraints() || rig.has_sync_bones() {
             return Err(Error::InvalidParameter(
-                "a chain crowd cannot step bone constraints (their chains step in groups): \
-                 run such characters through CharacterSim"
+                "a chain crowd cannot step bone constraints or sync bones: run such \
+                 characters through CharacterSim"
                     .into(),
             ));
         }

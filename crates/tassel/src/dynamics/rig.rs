@@ -3,7 +3,7 @@
 
 use crate::collide::{PlacedCollider, Shape};
 use crate::dynamics::chain::{
-    BoneConstraintOptions, BoneConstraintSettings, ChainSettings, Compliance,
+    BoneConstraintOptions, BoneConstraintSettings, ChainSettings, Compliance, SyncBoneSettings,
 };
 use crate::dynamics::cloth::ClothSettings;
 use crate::dynamics::rope::RopeSettings;
@@ -119,6 +119,10 @@ pub struct RigSettings {
         skip_serializing_if = "Vec::is_empty"
     )]
     pub bone_constraints: Vec<BoneConstraintSettings>,
+    /// Chain bones whose targets follow a source bone's movement (`[[sync_bone]]` tables;
+    /// KawaiiPhysics' sync bones).
+    #[serde(default, rename = "sync_bone", skip_serializing_if = "Vec::is_empty")]
+    pub sync_bones: Vec<SyncBoneSettings>,
 }
 
 fn one() -> u32 {
@@ -142,6 +146,7 @@ impl Default for RigSettings {
             cloths: Vec::new(),
             ropes: Vec::new(),
             bone_constraints: Vec::new(),
+            sync_bones: Vec::new(),
         }
     }
 }
@@ -235,6 +240,9 @@ impl RigSettings {
         }
         for (i, c) in self.bone_constraints.iter().enumerate() {
             c.validate(i + 1)?;
+        }
+        for (i, s) in self.sync_bones.iter().enumerate() {
+            s.validate(i + 1)?;
         }
         for r in &self.ropes {
             r.validate()?;

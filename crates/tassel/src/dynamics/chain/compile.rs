@@ -60,6 +60,9 @@ pub struct ChainRig {
     pub(crate) chain_in_lanes: Vec<bool>,
     /// Bone constraints and the chain groups they join.
     pub(crate) constraints: Constraints,
+    /// Sync bones, and per chain whether one moves its targets.
+    pub(crate) syncs: Vec<super::sync::CompiledSync>,
+    pub(crate) synced_chain: Vec<bool>,
     pub(crate) joint_count: usize,
 }
 
@@ -110,8 +113,12 @@ impl ChainRig {
             scalar_rotators: Vec::new(),
             chain_in_lanes: Vec::new(),
             constraints: Constraints::default(),
+            syncs: Vec::new(),
+            synced_chain: Vec::new(),
             joint_count: skeleton.len(),
         };
+        // Every point's rest length from its chain's root.
+        let mut point_rest_dist: Vec<f32> = Vec::new();
         out.colliders = CompiledCollider::compile_all(skeleton, rig);
         let mut owner: Vec<Option<usize>> = vec![None; skeleton.len()];
         for (ci, settings) in rig.chains.iter().enumerate() {
@@ -188,6 +195,7 @@ impl ChainRig {
             }
             let end = out.joint.len();
             out.chain_of.resize(end, ci as u16);
+            point_rest_dist.extend_from_slice(&rest_dist);
             let max_dist = rest_dist.iter().cloned().fold(0.0f32, f32::max).max(1e-6);
             let curves = &settings.curves;
             for &d in &rest_dist {
@@ -249,6 +257,19 @@ impl ChainRig {
                 .push((j, p, s..out.rotator_children.len() as u32));
         }
         out.constraints = out.compile_constraints(skeleton, rig, &rest.models)?;
+        out.syncs = super::sync::compile(
+            skeleton,
+            &rig.sync_bones,
+            &rest.models,
+            &out.joint,
+            &out.parent,
+            &out.chains,
+            &point_rest_dist,
+        )?;
+        out.synced_chain = vec![false; out.chains.len()];
+        for &(p, _) in out.syncs.iter().flat_map(|s| &s.targets) {
+            out.synced_chain[out.chain_of[p as usize] as usize] = true;
+        }
         let parents: Vec<Option<usize>> = (0..skeleton.len()).map(|j| skeleton.parent(j)).collect();
         out.lane_groups = crate::dynamics::chain::lanes::twins::plan(&parents, &out);
         out.chain_in_lanes = vec![false; out.chains.len()];
@@ -314,6 +335,18 @@ impl ChainRig {
             &table,
             &self.chains,
         )
+    }
+
+    /// Whether any sync bone moves this rig's chain targets (then those chains step per
+    /// character, not in a [`crate::crowd::ChainCrowd`]'s lanes).
+    pub fn has_sync_bones(&self) -> bool {
+        !self.syncs.is_empty()
+    }
+
+    /// Whether chain `ci` steps alone on the scalar path: bone constraints join it to
+    /// others, or a sync bone moves its targets.
+    pub(crate) fn steps_outside_lanes(&self, ci: usize) -> bool {
+        self.group_of(ci).is_some() || self.synced_chain.get(ci).copied().unwrap_or(false)
     }
 
     /// Whether any bone constraint joins this rig's chains (then its chains with

@@ -64,6 +64,9 @@ pub struct ChainState {
     /// and per chain whether the world is near.
     lambda: Vec<f32>,
     world_near: Vec<bool>,
+    /// The targets as the animation places them, before sync bones moved them (the
+    /// write-back turns bones from these); empty without sync bones.
+    animated: Vec<Vec3>,
 }
 
 impl ChainState {
@@ -108,6 +111,11 @@ impl ChainState {
             turned: Vec::with_capacity(rig.rotators.len()),
             lambda: vec![0.0; rig.constraints.list.len()],
             world_near: vec![false; c],
+            animated: if rig.syncs.is_empty() {
+                Vec::new()
+            } else {
+                vec![Vec3::ZERO; n]
+            },
         }
     }
 
@@ -174,7 +182,8 @@ impl ChainState {
         &self.out
     }
 
-    /// The animated target positions of the last frame, model space.
+    /// The animated target positions of the last frame, model space (as sync bones
+    /// moved them, where the rig has any).
     pub fn target_positions(&self) -> &[Vec3] {
         &self.targets
     }
@@ -250,6 +259,12 @@ impl ChainJob<'_> {
             && state.colliders.len() == self.rig.colliders.len()
             && state.lanes.len() == self.rig.lane_groups.len()
             && state.lambda.len() == self.rig.constraints.list.len()
+            && state.animated.len()
+                == if self.rig.syncs.is_empty() {
+                    0
+                } else {
+                    self.rig.point_count()
+                }
             && state
                 .lanes
                 .iter()
@@ -301,6 +316,26 @@ impl ChainJob<'_> {
             &mut state.normals,
             &mut state.colliders,
         );
+        if !rig.syncs.is_empty() {
+            state.animated.copy_from_slice(&state.targets);
+            // A chain that starts again this frame has no simulated points yet: its
+            // distance attenuation measures from the targets.
+            for ci in 0..rig.chains.len() {
+                if state.needs_reset[ci] && rig.synced_chain[ci] {
+                    for p in rig.chains[ci].points.clone() {
+                        state.pos[p] = state.targets[p];
+                    }
+                }
+            }
+            super::sync::apply(
+                &rig.syncs,
+                &rig.parent,
+                models,
+                &state.animated,
+                &state.pos,
+                &mut state.targets,
+            );
+        }
         for (b, c) in state.bounds.iter_mut().zip(&state.colliders) {
             *b = c.bound_sphere();
         }
@@ -364,7 +399,11 @@ impl ChainJob<'_> {
         write_back(
             skeleton,
             rig,
-            &state.targets,
+            if rig.syncs.is_empty() {
+                &state.targets
+            } else {
+                &state.animated
+            },
             &state.out,
             locals,
             models,

@@ -12,8 +12,10 @@ pub(crate) mod job;
 pub(crate) mod lanes;
 mod settings;
 pub(crate) mod step;
+pub(crate) mod sync;
 
 pub use compile::{ChainRig, PointInfo};
 pub use constraint::{BoneConstraintOptions, BoneConstraintSettings, Compliance, CompliancePreset};
 pub use job::{ChainJob, ChainState};
 pub use settings::{ChainCurves, ChainSettings, ClassicGravity, PlanarAxis, TimeMode, Wind};
+pub use sync::{SyncBoneSettings, SyncDirection, SyncTargetSettings};

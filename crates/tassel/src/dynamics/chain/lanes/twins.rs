@@ -90,8 +90,9 @@ pub(crate) fn plan(sk_parent: &[Option<usize>], rig: &ChainRig) -> Vec<ChainLane
     // Each key's group still open (fewer than LANES chains): one look-up per chain.
     let mut open: std::collections::HashMap<_, usize> = std::collections::HashMap::new();
     for ci in 0..rig.chains.len() {
-        // Chains joined by bone constraints step with their group.
-        if rig.chains[ci].settings.world_collision || rig.group_of(ci).is_some() {
+        // Chains joined by bone constraints step with their group; sync bones move targets
+        // the lanes do not read.
+        if rig.chains[ci].settings.world_collision || rig.steps_outside_lanes(ci) {
             continue;
         }
         let key = twin_key(rig, ci);
@@ -279,6 +280,8 @@ fn one_chain(rig: &ChainRig, ci: usize) -> ChainRig {
         rotators: Vec::new(),
         rotator_children: Vec::new(),
         constraints: Default::default(),
+        syncs: Vec::new(),
+        synced_chain: Vec::new(),
         lane_groups: Vec::new(),
         scalar_rotators: Vec::new(),
         chain_in_lanes: Vec::new(),

@@ -1,4 +1,5 @@
-//! Bone constraints (issue 49, part 1) against KawaiiPhysics 1.20 itself: an independent
+//! Bone constraints and sync bones (issue 49, parts 1 and 4) against KawaiiPhysics 1.20
+//! itself: an independent
 //! port, in f64 and in this file, of `FAnimNode_KawaiiPhysics::SimulateModifyBones` as the
 //! plugin's `20260106-v1.20.0` tag ships it, for what a skirt of chains uses: every bone
 //! integrated first (Verlet velocity over the previous frame's dt, damping, gravity into the
@@ -12,18 +13,26 @@
 //! which has nothing to do here). No colliders, wind or limits here: their differences are
 //! the chains' own (docs/chains.md).
 //!
+//! `ApplySyncBones` (before the simulation: the source's component-space movement from its
+//! reference place, scaled by its distance curve and per-axis global scale, filtered by
+//! sign per axis, attenuated by distance to each target's simulated point, scaled by each
+//! target's length-rate curve, and put on the targets' pose keeping their bone lengths) is
+//! ported the same way, with the curves evaluated piecewise-linearly as Tassel's are
+//! (Unreal's default keys are cubic: a documented difference).
+//!
 //! An 8-column skirt ring (each column a chain of 3 bones and a dummy tip), neighbouring
-//! columns joined at every level, 120 frames at 30, 60 and 144 Hz, the character still,
-//! swaying, stepped and turning: every simulated point of Tassel's `classic` output agrees
-//! with the port to 2e-5 m.
+//! columns joined at every level, a left thigh swinging under it, 120 frames at 30, 60 and
+//! 144 Hz, the character still, swaying, stepped and turning: every simulated point of
+//! Tassel's `classic` output agrees with the port to 2e-5 m.
 
 use glam::{DQuat, DVec3, Quat, Vec3};
 use std::sync::Arc;
 use tassel::crowd::{ChainCrowd, CrowdKind};
 use tassel::dynamics::chain::{
     BoneConstraintSettings, ChainRig, ChainSettings, ClassicGravity, Compliance, CompliancePreset,
-    TimeMode,
+    SyncBoneSettings, SyncDirection, SyncTargetSettings, TimeMode,
 };
+use tassel::dynamics::Curve;
 use tassel::dynamics::RigSettings;
 use tassel::{CharacterRig, CharacterSim, Skeleton, Transform};
 
@@ -48,6 +57,28 @@ fn joint_pose(k: usize, i: usize) -> DVec3 {
     DVec3::new(0.17 * s, 0.98, 0.17 * c) + i as f64 * DVec3::new(0.035 * s, -0.1, 0.035 * c)
 }
 
+/// The left thigh's place (model space) and the knee below it, 0.4 m down the thigh.
+const THIGH: [f64; 3] = [0.09, 0.97, 0.0];
+const KNEE: f64 = 0.4;
+
+/// The thigh's swing about X at `t` seconds (radians; negative swings the knee forward).
+fn thigh_angle(t: f64) -> f64 {
+    -0.7 * (std::f64::consts::TAU * 0.8 * t).sin()
+}
+
+/// The knee's component-space place at `t`.
+fn knee_at(t: f64) -> DVec3 {
+    DVec3::from(THIGH) + DQuat::from_rotation_x(thigh_angle(t)) * DVec3::new(0.0, -KNEE, 0.0)
+}
+
+/// The animated locals at `t`: the rest pose with the thigh swung.
+fn locals_at(sk: &Skeleton, t: f64) -> Vec<Transform> {
+    let mut locals = sk.rest().to_vec();
+    let thigh = sk.find("thigh_l").unwrap();
+    locals[thigh].rotation = Quat::from_rotation_x(thigh_angle(t) as f32);
+    locals
+}
+
 fn skeleton() -> Skeleton {
     let mut names = vec!["hips".to_string()];
     let mut parents = vec![None];
@@ -66,6 +97,18 @@ fn skeleton() -> Skeleton {
             ));
         }
     }
+    names.push("thigh_l".into());
+    parents.push(Some(0));
+    rest.push(Transform::from_translation(
+        (DVec3::from(THIGH) - DVec3::new(0.0, 1.0, 0.0)).as_vec3(),
+    ));
+    names.push("knee_l".into());
+    parents.push(Some(names.len() - 2));
+    rest.push(Transform::from_translation(Vec3::new(
+        0.0,
+        -KNEE as f32,
+        0.0,
+    )));
     Skeleton::new(names, parents, rest).unwrap()
 }
 
@@ -122,6 +165,52 @@ fn rig(mode: TimeMode, compliance: Option<Compliance>, before: u32, after: u32) 
     }
 }
 
+const GLOBAL_SCALE: [f64; 3] = [1.0, 0.5, 1.0];
+const DELTA_CURVE: [[f64; 2]; 2] = [[0.0, 1.0], [0.4, 0.5]];
+const RATE_CURVE: [[f64; 2]; 2] = [[0.0, 0.4], [1.0, 1.0]];
+const ATTENUATION: [f64; 3] = [0.25, 0.6, 0.7];
+
+/// The knee pushes the front of the skirt: `skirt_0_1` and the bones below it (a share
+/// growing along them), `skirt_1_1` alone and `skirt_7_1` with the bones below it; only
+/// its forward (+Z) movement, half of its vertical one, attenuated with distance.
+fn sync_bone() -> SyncBoneSettings {
+    let curve =
+        |k: [[f64; 2]; 2]| Curve::new(k.iter().map(|k| [k[0] as f32, k[1] as f32]).collect());
+    SyncBoneSettings {
+        bone: "knee_l".into(),
+        target_roots: vec![
+            SyncTargetSettings {
+                bone: "skirt_0_1".into(),
+                scale_curve_by_bone_length_rate: curve(RATE_CURVE),
+                ..Default::default()
+            },
+            SyncTargetSettings {
+                bone: "skirt_1_1".into(),
+                include_child_bones: false,
+                ..Default::default()
+            },
+            SyncTargetSettings {
+                bone: "skirt_7_1".into(),
+                ..Default::default()
+            },
+        ],
+        global_scale: Vec3::from(GLOBAL_SCALE.map(|g| g as f32)),
+        scale_curve_by_delta_distance: curve(DELTA_CURVE),
+        apply_direction_z: SyncDirection::Positive,
+        enable_distance_attenuation: true,
+        attenuation_inner_radius: ATTENUATION[0] as f32,
+        attenuation_outer_radius: ATTENUATION[1] as f32,
+        max_attenuation_rate: ATTENUATION[2] as f32,
+        ..Default::default()
+    }
+}
+
+/// A piecewise-linear curve through two keys, clamped (Tassel's rule).
+fn linear(k: [[f64; 2]; 2], x: f64) -> f64 {
+    let w = ((x - k[0][0]) / (k[1][0] - k[0][0])).clamp(0.0, 1.0);
+    k[0][1] + (k[1][1] - k[0][1]) * w
+}
+
 /// KawaiiPhysics 1.20's update of the skirt, in a float type of choice (f64: the
 /// reference; f32: how far rounding alone moves the same update).
 macro_rules! kawaii {
@@ -139,10 +228,15 @@ macro_rules! kawaii {
             after: u32,
             dt_old: $f,
             prev_comp: ($v, $q),
+            /// The pose before sync bones move it, each bone's reference length, and
+            /// the sync targets (point, scale by length rate) when the knee syncs.
+            rest_pose: Vec<$v>,
+            bone_length: Vec<$f>,
+            sync: Vec<(usize, $f)>,
         }
 
         impl $name {
-            fn new(compliance: Option<f64>, before: u32, after: u32) -> Self {
+            fn new(compliance: Option<f64>, before: u32, after: u32, sync: bool) -> Self {
                 let (mut pose, mut parent) = (Vec::new(), Vec::new());
                 let point = |k: usize, i: usize| k * (LEVELS + 2) + i;
                 for k in 0..COLUMNS {
@@ -171,7 +265,52 @@ macro_rules! kawaii {
                     }
                 }
                 constraints.extend(dummies);
+                let bone_length: Vec<$f> = (0..pose.len())
+                    .map(|i| parent[i].map_or(0.0, |p: usize| (pose[i] - pose[p]).length()))
+                    .collect();
+                // InitSyncBone: each target root and (with its children) the bones below
+                // it, each with its length rate from the root through the curve.
+                let mut targets = Vec::new();
+                if sync {
+                    let from_root = |i: usize| {
+                        let mut l = 0.0 as $f;
+                        let mut j = i;
+                        while let Some(p) = parent[j] {
+                            l += bone_length[j];
+                            j = p;
+                        }
+                        l
+                    };
+                    for (k, children, curve) in
+                        [(0usize, true, true), (1, false, false), (7, true, false)]
+                    {
+                        let root = point(k, 1);
+                        let members: Vec<usize> = if children {
+                            (root..point(k, LEVELS + 1) + 1).collect()
+                        } else {
+                            vec![root]
+                        };
+                        let start = from_root(root);
+                        let max = members.iter().map(|&i| from_root(i)).fold(start, <$f>::max);
+                        for i in members {
+                            let rate = if max - start > 1e-6 {
+                                (from_root(i) - start) / (max - start)
+                            } else {
+                                0.0
+                            };
+                            let scale = if curve {
+                                linear(RATE_CURVE, rate as f64) as $f
+                            } else {
+                                1.0
+                            };
+                            targets.push((i, scale));
+                        }
+                    }
+                }
                 Self {
+                    rest_pose: pose.clone(),
+                    bone_length,
+                    sync: targets,
                     location: pose.clone(),
                     prev_location: pose.clone(),
                     pose,
@@ -211,7 +350,45 @@ macro_rules! kawaii {
                 }
             }
 
-            fn frame(&mut self, comp: (DVec3, DQuat), dt: f64) {
+            /// `ApplySyncBones` with the knee at `knee` (component space).
+            fn apply_sync(&mut self, knee: DVec3) {
+                self.pose.copy_from_slice(&self.rest_pose);
+                if self.sync.is_empty() {
+                    return;
+                }
+                let knee = ($to_v)(knee);
+                let rest_knee = ($to_v)(knee_at(0.0));
+                let mut delta = knee - rest_knee;
+                delta *= linear(DELTA_CURVE, delta.length() as f64) as $f;
+                delta *= ($to_v)(DVec3::from(GLOBAL_SCALE));
+                // Z: the positive direction only.
+                if delta.z <= 0.0 {
+                    delta.z = 0.0;
+                }
+                // FVector::IsNearlyZero (1e-4 cm = 1e-6 m per component).
+                if delta.abs().max_element() <= 1e-6 {
+                    return;
+                }
+                let [inner, outer, max] = ATTENUATION.map(|a| a as $f);
+                for &(i, scale) in &self.sync {
+                    let distance = (knee - self.location[i]).length();
+                    let amount = if distance <= inner {
+                        0.0
+                    } else if distance >= outer {
+                        max
+                    } else {
+                        (distance - inner) / (outer - inner) * max
+                    };
+                    let alpha = (1.0 - amount).max(0.0);
+                    let moved = self.pose[i] + delta * alpha * scale;
+                    let p = self.parent[i].unwrap();
+                    self.pose[i] = (moved - self.pose[p]).normalize_or_zero() * self.bone_length[i]
+                        + self.pose[p];
+                }
+            }
+
+            fn frame(&mut self, comp: (DVec3, DQuat), dt: f64, knee: DVec3) {
+                self.apply_sync(knee);
                 let comp: ($v, $q) = (($to_v)(comp.0), ($to_q)(comp.1));
                 let dt = dt as $f;
                 let inv = comp.1.inverse();
@@ -300,8 +477,8 @@ fn tassel_point(sim: &CharacterSim, k: usize, i: usize) -> DVec3 {
     sim.chain_state().output_positions()[p].as_dvec3()
 }
 
-#[test]
-fn classic_matches_kawaiiphysics_1_20_bone_constraints() {
+/// Tassel's classic skirt against the port, with or without the knee syncing the front.
+fn compare_classic(sync: bool) -> f64 {
     let sk = skeleton();
     let cases = [
         (CompliancePreset::Leather, 0, 1),
@@ -311,62 +488,85 @@ fn classic_matches_kawaiiphysics_1_20_bone_constraints() {
     let mut worst_all = 0.0f64;
     for (preset, before, after) in cases {
         let compliance = Some(Compliance::Preset(preset));
-        let rig = rig(TimeMode::Classic, compliance, before, after);
+        let mut rig = rig(TimeMode::Classic, compliance, before, after);
+        if sync {
+            rig.sync_bones = vec![sync_bone()];
+        }
         for motion in ["still", "sway", "step", "turn"] {
             for hz in [30.0f64, 60.0, 144.0] {
                 let mut sim = CharacterSim::new(sk.clone(), &rig).unwrap();
                 let value = Some(preset.value() as f64);
-                let mut kp = Kawaii::new(value, before, after);
-                let mut kp32 = Kawaii32::new(value, before, after);
-                let mut free = Kawaii::new(None, 0, 0);
-                let rest = sk.rest().to_vec();
-                sim.frame(&rest, Transform::IDENTITY, 0.0).unwrap();
+                let mut kp = Kawaii::new(value, before, after, sync);
+                let mut kp32 = Kawaii32::new(value, before, after, sync);
+                // What the feature under test changes: the same port without it.
+                let mut without = if sync {
+                    Kawaii::new(value, before, after, false)
+                } else {
+                    Kawaii::new(None, 0, 0, false)
+                };
+                sim.frame(&locals_at(&sk, 0.0), Transform::IDENTITY, 0.0)
+                    .unwrap();
                 let (mut worst, mut rounding, mut effect) = (0.0f64, 0.0f64, 0.0f64);
                 for f in 1..=120 {
                     let t = f as f64 / hz;
                     let (pos, rot) = component(motion, t);
-                    kp.frame((pos, rot), 1.0 / hz);
-                    kp32.frame((pos, rot), 1.0 / hz);
-                    free.frame((pos, rot), 1.0 / hz);
+                    let knee = knee_at(t);
+                    kp.frame((pos, rot), 1.0 / hz, knee);
+                    kp32.frame((pos, rot), 1.0 / hz, knee);
+                    without.frame((pos, rot), 1.0 / hz, knee);
                     let comp = Transform::from_translation_rotation(pos.as_vec3(), rot.as_quat());
-                    sim.frame(&rest, comp, (1.0 / hz) as f32).unwrap();
+                    sim.frame(&locals_at(&sk, t), comp, (1.0 / hz) as f32)
+                        .unwrap();
                     for k in 0..COLUMNS {
                         for i in 1..=LEVELS + 1 {
                             let got = tassel_point(&sim, k, i);
                             worst = worst.max((got - kp.point(k, i)).length());
                             rounding = rounding.max((kp32.point(k, i) - kp.point(k, i)).length());
-                            effect = effect.max((free.point(k, i) - kp.point(k, i)).length());
+                            effect = effect.max((without.point(k, i) - kp.point(k, i)).length());
                         }
                     }
                 }
+                let what = if sync { "sync bones" } else { "constraints" };
                 println!(
-                    "{preset:?} before {before} after {after}, {motion} {hz} Hz: Tassel vs \
+                    "{preset:?} before {before} after {after}, {motion} {hz} Hz{}: Tassel vs \
                      KawaiiPhysics 1.20 (f64) {worst:.2e} m; f32 rounding {rounding:.2e} m; \
-                     the constraints move points by up to {effect:.2e} m"
+                     the {what} move points by up to {effect:.2e} m",
+                    if sync { ", knee synced" } else { "" }
                 );
                 assert!(
                     worst <= 2e-5_f64.max(2.0 * rounding),
                     "{preset:?} {motion} {hz} Hz: {worst} m (f32 rounding alone: {rounding} m)"
                 );
-                if motion != "still" {
-                    // The constraints matter in this scene, or the test shows nothing.
+                if motion != "still" || sync {
+                    // The feature matters in this scene, or the test shows nothing.
                     assert!(
                         effect > 1e-3,
-                        "{preset:?} {motion}: constraints moved {effect} m"
+                        "{preset:?} {motion}: the {what} moved {effect} m"
                     );
                 }
                 worst_all = worst_all.max(worst);
             }
         }
     }
-    println!("worst over every case: {worst_all:.2e} m");
+    worst_all
+}
+
+#[test]
+fn classic_matches_kawaiiphysics_1_20_bone_constraints() {
+    let worst = compare_classic(false);
+    println!("worst over every case: {worst:.2e} m");
+}
+
+#[test]
+fn classic_matches_kawaiiphysics_1_20_sync_bones() {
+    let worst = compare_classic(true);
+    println!("worst over every case, knee synced: {worst:.2e} m");
 }
 
 /// World positions of every skirt joint, sampled every 1/6 s, over 6 s of sway and turn.
 fn fixed_run(rig: &RigSettings, hz: u32) -> (Vec<Vec<Vec3>>, Vec<Vec<Vec3>>) {
     let sk = skeleton();
     let mut sim = CharacterSim::new(sk.clone(), rig).unwrap();
-    let rest = sk.rest().to_vec();
     let (mut sim_pos, mut anim_pos) = (Vec::new(), Vec::new());
     for f in 0..=6 * hz {
         let t = f as f64 / hz as f64;
@@ -375,7 +575,7 @@ fn fixed_run(rig: &RigSettings, hz: u32) -> (Vec<Vec<Vec3>>, Vec<Vec<Vec3>>) {
             Quat::from_rotation_y((0.5 * (std::f64::consts::TAU * 0.7 * t).sin()) as f32),
         );
         let dt = if f == 0 { 0.0 } else { 1.0 / hz as f32 };
-        sim.frame(&rest, comp, dt).unwrap();
+        sim.frame(&locals_at(&sk, t), comp, dt).unwrap();
         if (f * 6) % hz == 0 {
             let world = |ms: &[Transform]| -> Vec<Vec3> {
                 ms.iter()
@@ -390,9 +590,16 @@ fn fixed_run(rig: &RigSettings, hz: u32) -> (Vec<Vec<Vec3>>, Vec<Vec<Vec3>>) {
 }
 
 #[test]
-fn fixed_mode_with_bone_constraints_is_frame_rate_independent() {
-    for preset in [CompliancePreset::Leather, CompliancePreset::Fat] {
-        let rig = rig(TimeMode::Fixed, Some(Compliance::Preset(preset)), 1, 2);
+fn fixed_mode_with_bone_constraints_and_sync_bones_is_frame_rate_independent() {
+    for (preset, sync) in [
+        (CompliancePreset::Leather, false),
+        (CompliancePreset::Fat, false),
+        (CompliancePreset::Fat, true),
+    ] {
+        let mut rig = rig(TimeMode::Fixed, Some(Compliance::Preset(preset)), 1, 2);
+        if sync {
+            rig.sync_bones = vec![sync_bone()];
+        }
         let (reference, anim) = fixed_run(&rig, 144);
         let (mut dev2, mut n) = (0.0f64, 0usize);
         for (s, a) in reference.iter().zip(&anim) {
@@ -412,7 +619,8 @@ fn fixed_mode_with_bone_constraints_is_frame_rate_independent() {
                 .sum();
             let rel = (d2 / n as f64).sqrt() / dev_rms;
             println!(
-                "{preset:?}: {hz} Hz vs 144 Hz: {:.3} % of the RMS dynamic deviation ({:.1} mm)",
+                "{preset:?}{}: {hz} Hz vs 144 Hz: {:.3} % of the RMS dynamic deviation ({:.1} mm)",
+                if sync { ", knee synced" } else { "" },
                 100.0 * rel,
                 1e3 * dev_rms
             );
@@ -799,11 +1007,12 @@ fn the_example_skirt_of_chains_runs_the_demo_on_the_builtin_character() {
     let rig = RigSettings::from_toml_str(&text).unwrap();
     let c = tassel::builtin::character();
     let mut sim = CharacterSim::new(c.skeleton.clone(), &rig).unwrap();
-    assert!(sim.chains().has_bone_constraints());
+    assert!(sim.chains().has_bone_constraints() && sim.chains().has_sync_bones());
     assert_eq!(sim.chains().chain_count(), 8);
-    // The same skirt without its constraints, for comparison.
+    // The same skirt without its constraints (and sync bones), for comparison.
     let mut free_rig = rig.clone();
     free_rig.bone_constraints.clear();
+    free_rig.sync_bones.clear();
     let mut free = CharacterSim::new(c.skeleton.clone(), &free_rig).unwrap();
     let script = tassel::builtin::DemoScript;
     let mut animator = script.animator(&c);
@@ -865,4 +1074,107 @@ fn the_example_skirt_of_chains_runs_the_demo_on_the_builtin_character() {
         1e3 * strain_free
     );
     assert!(strain < strain_free, "{strain} vs {strain_free}");
+}
+
+#[test]
+fn sync_bones_read_from_the_rig_file_and_bad_ones_are_named() {
+    let text = r#"
+[[chain]]
+name = "front"
+root = "skirt_0_0"
+dummy_bone_length = 0.05
+
+[[sync_bone]]
+bone = "knee_l"
+global_scale = [1.0, 0.5, 1.0]
+scale_curve_by_delta_distance = [[0.0, 1.0], [0.4, 0.5]]
+apply_direction_z = "positive"
+apply_direction_x = "none"
+enable_distance_attenuation = true
+attenuation_inner_radius = 0.25
+attenuation_outer_radius = 0.6
+max_attenuation_rate = 0.7
+
+[[sync_bone.target_root]]
+bone = "skirt_0_0"
+scale_curve_by_bone_length_rate = [[0.0, 0.4], [1.0, 1.0]]
+"#;
+    let rig = RigSettings::from_toml_str(text).unwrap();
+    let s = &rig.sync_bones[0];
+    assert_eq!(s.apply_direction_z, SyncDirection::Positive);
+    assert_eq!(s.apply_direction_x, SyncDirection::None);
+    assert_eq!(s.apply_direction_y, SyncDirection::Both);
+    assert!(s.target_roots[0].include_child_bones);
+    // Halfway between the keys 0.4 and 1.0 (f32 rounding aside).
+    assert!((s.target_roots[0].scale_curve_by_bone_length_rate.eval(0.5) - 0.7).abs() < 1e-6);
+    let again = RigSettings::from_toml_str(&rig.to_toml_string().unwrap()).unwrap();
+    assert_eq!(again, rig);
+    // A chain's root as the target root: the bones below it take the movement (the
+    // root stays animated), so the chain's tip leaves its pose when the knee swings.
+    let sk = skeleton();
+    let mut sim = CharacterSim::new(sk.clone(), &rig).unwrap();
+    assert!(sim.chains().has_sync_bones());
+    let tip = sk.find("skirt_0_3").unwrap();
+    let mut moved = 0.0f32;
+    for f in 0..60 {
+        let t = f as f64 / 60.0;
+        sim.frame(
+            &locals_at(&sk, t),
+            Transform::IDENTITY,
+            if f == 0 { 0.0 } else { 1.0 / 60.0 },
+        )
+        .unwrap();
+        moved = moved.max(
+            sim.chain_state().target_positions()[3]
+                .distance(sim.animated_models()[tip].translation),
+        );
+    }
+    assert!(moved > 0.01, "the synced target moved {moved} m");
+    let rig_of = |edit: &dyn Fn(&mut SyncBoneSettings)| {
+        let mut r = rig.clone();
+        edit(&mut r.sync_bones[0]);
+        r
+    };
+    let cases: Vec<(RigSettings, &[&str])> = vec![
+        (
+            rig_of(&|s| s.bone = "nope".into()),
+            &["sync_bone #1", "nope"],
+        ),
+        (
+            rig_of(&|s| s.target_roots[0].bone = "hips".into()),
+            &["sync_bone #1", "hips", "no chain"],
+        ),
+        (
+            rig_of(&|s| s.global_scale = Vec3::new(1.5, 1.0, 1.0)),
+            &["sync_bone #1", "global_scale"],
+        ),
+        (
+            rig_of(&|s| s.attenuation_outer_radius = -1.0),
+            &["sync_bone #1", "attenuation_outer_radius"],
+        ),
+        (
+            rig_of(&|s| s.max_attenuation_rate = f32::NAN),
+            &["sync_bone #1", "max_attenuation_rate"],
+        ),
+        (
+            rig_of(&|s| s.target_roots.clear()),
+            &["sync_bone #1", "target_root"],
+        ),
+        (
+            rig_of(&|s| s.scale_curve_by_delta_distance = Curve::new(vec![[1.0, 1.0], [0.0, 1.0]])),
+            &["sync_bone #1", "scale_curve_by_delta_distance"],
+        ),
+    ];
+    for (r, words) in cases {
+        let e = match RigSettings::from_toml_str(&r.to_toml_string().unwrap()) {
+            Err(e) => e.to_string(),
+            Ok(_) => CharacterSim::new(sk.clone(), &r).unwrap_err().to_string(),
+        };
+        for w in words {
+            assert!(e.contains(w), "'{e}' does not name {w}");
+        }
+    }
+    // Crowds step such characters one by one.
+    let rig = Arc::new(CharacterRig::new(sk.clone(), &rig).unwrap());
+    assert_eq!(CrowdKind::of(&rig), None);
 }
