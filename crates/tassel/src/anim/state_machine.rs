@@ -120,6 +120,46 @@ struct Transition {
 }
 
 /// A compiled state machine (shareable between characters).
+///
+/// ```
+/// use tassel::anim::{BlendPlan, StateMachine};
+///
+/// let toml = r#"
+/// initial = "idle"
+///
+/// [parameters]
+/// speed = { type = "float" }
+///
+/// [[state]]
+/// name = "idle"
+/// clip = "idle"
+///
+/// [[state]]
+/// name = "walk"
+/// clip = "walk"
+///
+/// [[transition]]
+/// from = "idle"
+/// to = "walk"
+/// when = ["speed > 0.5"]
+/// fade = 0.2
+/// "#;
+/// let machine = StateMachine::from_toml_str(toml, &["idle", "walk"], &[2.0, 1.0])?;
+/// let mut state = machine.new_state();
+/// let mut plan = BlendPlan::default();
+/// machine.update(&mut state, 0.1, &mut plan);
+/// assert_eq!(machine.state_name(plan.state), "idle");
+///
+/// state.set(machine.param("speed").unwrap(), 1.2);
+/// machine.update(&mut state, 0.1, &mut plan);
+/// assert_eq!(machine.state_name(plan.state), "walk");
+/// assert!(plan.transitioned);
+/// // 0.1 s into the 0.2 s fade: both clips play at half weight.
+/// machine.update(&mut state, 0.1, &mut plan);
+/// assert_eq!(plan.layers.len(), 2);
+/// assert!(plan.layers.iter().all(|l| (l.weight - 0.5).abs() < 1e-6));
+/// # Ok::<(), tassel::Error>(())
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct StateMachine {
     params: Vec<(String, ParamKind, f32)>,
