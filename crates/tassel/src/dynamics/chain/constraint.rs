@@ -445,6 +445,7 @@ pub(crate) fn compile(
     let mut constrained = vec![false; chains.len()];
     for c in &list {
         constrained[points.chain_of[c.a as usize] as usize] = true;
+        constrained[points.chain_of[c.b as usize] as usize] = true;
     }
     for ci in 0..chains.len() {
         if !constrained[ci] {
