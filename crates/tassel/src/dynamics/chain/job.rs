@@ -345,10 +345,9 @@ impl ChainJob<'_> {
         // One broad-phase query for the whole character; away from all geometry the
         // chains ask the level nothing more.
         let level = level.filter(|level| near_character(rig, state, &component, level));
-        // A chain's frame reads nothing of another chain's: the twin chains in lanes run
-        // after the others.
-        // Chains joined by bone constraints run as one group, when its first chain's turn
-        // comes.
+        // A chain's frame reads nothing of another chain's, except within a group of chains
+        // joined by bone constraints, which runs as one when its first chain's turn comes;
+        // the twin chains in lanes run after the others.
         for ci in 0..rig.chains.len() {
             if lanes && rig.in_lane_group(ci) {
                 continue;

@@ -138,6 +138,23 @@ impl<'a> Contact<'a> {
         }
     }
 
+    /// [`Contact::of`] for point `p` where it is now (`pos[p]`), its parent `pp` at its
+    /// current place: a group's collision and finishing passes.
+    #[inline]
+    fn at(
+        rig: &ChainRig,
+        list: &'a [usize],
+        input: &'a StepInput<'a>,
+        p: usize,
+        pp: usize,
+        pos: &[Vec3],
+        prev: &[Vec3],
+    ) -> Self {
+        let t = input.targets;
+        let length = (t[p] - t[pp]).length();
+        Self::of(rig, list, input, p, pos[pp], length, pos[p], prev[p])
+    }
+
     #[inline]
     fn resolve(&self, x: Vec3) -> Vec3 {
         let mut x = self
@@ -276,28 +293,17 @@ pub(crate) fn step_group<'a>(
     solve(list, lambda, pos, dt, rig.constraints.before);
     for &ci in &group.chains {
         let chain = &rig.chains[ci];
-        if chain.colliders.is_empty() && input_of(ci).world.is_none() {
+        let input = input_of(ci);
+        if chain.colliders.is_empty() && input.world.is_none() {
             continue;
         }
-        let input = input_of(ci);
-        let t = input.targets;
         for p in chain.points.clone() {
             let parent = rig.parent[p];
             if parent == NONE {
                 continue;
             }
             let pp = parent as usize;
-            let length = (t[p] - t[pp]).length();
-            let contact = Contact::of(
-                rig,
-                &chain.colliders,
-                &input,
-                p,
-                pos[pp],
-                length,
-                pos[p],
-                prev[p],
-            );
+            let contact = Contact::at(rig, &chain.colliders, &input, p, pp, pos, prev);
             pos[p] = contact.resolve(pos[p]);
         }
     }
@@ -305,7 +311,6 @@ pub(crate) fn step_group<'a>(
     for &ci in &group.chains {
         let chain = &rig.chains[ci];
         let input = input_of(ci);
-        let t = input.targets;
         let collides = !chain.colliders.is_empty() || input.world.is_some();
         for p in chain.points.clone() {
             let parent = rig.parent[p];
@@ -313,17 +318,7 @@ pub(crate) fn step_group<'a>(
                 continue;
             }
             let pp = parent as usize;
-            let length = (t[p] - t[pp]).length();
-            let contact = Contact::of(
-                rig,
-                &chain.colliders,
-                &input,
-                p,
-                pos[pp],
-                length,
-                pos[p],
-                prev[p],
-            );
+            let contact = Contact::at(rig, &chain.colliders, &input, p, pp, pos, prev);
             pos[p] = finish(
                 rig,
                 &chain.settings,
