@@ -62,6 +62,22 @@ fn spawn_scene_with(
     rig: Option<&Handle<TasselRig>>,
     crowd: bool,
 ) -> Entity {
+    let (scene, model) = load_scene(app, file);
+    let mut motion = SecondaryMotion::new(model).with_mode(mode);
+    if let Some(rig) = rig {
+        motion = motion.with_rig(rig.clone());
+    }
+    if !crowd {
+        motion = motion.without_crowd();
+    }
+    app.world_mut()
+        .spawn((WorldAssetRoot(scene), motion, Transform::default()))
+        .id()
+}
+
+/// The handles of `file`'s first scene (without meshes, materials, cameras, lights or
+/// animations) and of its model, as [`spawn_scene_with`] loads them.
+fn load_scene(app: &mut App, file: &str) -> (Handle<WorldAsset>, Handle<TasselModel>) {
     let server = app.world().resource::<AssetServer>().clone();
     let scene: Handle<WorldAsset> = server
         .load_builder()
@@ -74,16 +90,7 @@ fn spawn_scene_with(
         })
         .load(GltfAssetLabel::Scene(0).from_asset(file.to_string()));
     let model = server.load::<TasselModel>(file.to_string());
-    let mut motion = SecondaryMotion::new(model).with_mode(mode);
-    if let Some(rig) = rig {
-        motion = motion.with_rig(rig.clone());
-    }
-    if !crowd {
-        motion = motion.without_crowd();
-    }
-    app.world_mut()
-        .spawn((WorldAssetRoot(scene), motion, Transform::default()))
-        .id()
+    (scene, model)
 }
 
 #[derive(Component)]
@@ -295,6 +302,16 @@ fn crowd_characters_move_as_their_own_sims_move_them() {
                 .resource_mut::<Assets<TasselRig>>()
                 .add(TasselRig(r))
         });
+        // The file loaded before the first frame counted, so that the pairs start on the
+        // frames they are spawned (loading runs on other threads: on a busy machine it took
+        // most of the 150 frames, and too few bones were compared).
+        let held = load_scene(&mut app, file);
+        let loaded = update_until(&mut app, 5000, |app| {
+            let server = app.world().resource::<AssetServer>();
+            server.is_loaded_with_dependencies(&held.0)
+                && server.is_loaded_with_dependencies(&held.1)
+        });
+        assert!(loaded, "{file}: the scene and the model load");
         // Pairs (crowd, own sim), spawned on frames 0, 5 and 12; pair 1 leaves on frame 60.
         let mut pairs: Vec<(Entity, Entity)> = Vec::new();
         let mut compared = 0usize;

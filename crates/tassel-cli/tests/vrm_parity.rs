@@ -85,7 +85,10 @@ fn files() -> Vec<PathBuf> {
 /// with motions `sin`, `step` and `rotate`, 120 frames; with `limit`, asserts every tail
 /// within it on every frame; returns the worst distance.
 fn parity(oracle: &Path, hooks: Option<&str>, mode: &str, what: &str, limit: Option<f64>) -> f64 {
-    let out = tmp(&format!("vrm-parity-{mode}"));
+    // One folder per test: two tests run `spec` side by side (one with the hook), and a
+    // shared folder emptied by one while the other read it failed once.
+    let hooked = if hooks.is_some() { "hooked" } else { "plain" };
+    let out = tmp(&format!("vrm-parity-{mode}-{hooked}"));
     let mut worst_all = 0.0f64;
     for file in &files() {
         for motion in ["sin", "step", "rotate"] {
