@@ -34,6 +34,11 @@ declare class Stepped {
   reset(): void;
   setInitState(): void;
   teleport(): void;
+  /** Acts on an animation event starting with `tassel:` (`tassel:reset_dynamics`,
+   *  `tassel:set_alpha 0.3 [chain]`, `tassel:enable_force NAME`, `tassel:disable_force NAME`,
+   *  `tassel:force_once NAME`): true when it acted, false for the game's own events;
+   *  throws on a malformed one or a name that does not exist. */
+  event(name: string): boolean;
   dispose(): void;
 }
 

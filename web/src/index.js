@@ -319,6 +319,21 @@ class Driver {
     this.tassel.x.tassel_teleport(this.ptr);
   }
 
+  /** Acts on an animation event starting with `tassel:` (`tassel:reset_dynamics`,
+   *  `tassel:set_alpha 0.3 [chain]`, `tassel:enable_force NAME`, `tassel:disable_force
+   *  NAME`, `tassel:force_once NAME`): true when it acted, false for the game's own
+   *  events; throws on a malformed one or a name that does not exist. */
+  event(name) {
+    const text = this.tassel.cstring(name);
+    try {
+      const r = this.tassel.x.tassel_event(this.ptr, text[0]);
+      if (r < 0) throw this.tassel.error('the event failed');
+      return r === 1;
+    } finally {
+      this.tassel.free(text);
+    }
+  }
+
   update(delta) {
     const x = this.tassel.x;
     const locals = this.locals();
@@ -429,6 +444,12 @@ class Stepped {
   setInitState() { this._driver.setInitState(); }
   /** The character was moved on purpose: start again at the new place, no whip. */
   teleport() { this._driver.teleport(); }
+
+  /** Acts on an animation event starting with `tassel:` (`tassel:reset_dynamics`,
+   *  `tassel:set_alpha 0.3 [chain]`, `tassel:enable_force NAME`, `tassel:disable_force
+   *  NAME`, `tassel:force_once NAME`): true when it acted, false for the game's own events;
+   *  throws on a malformed one or a name that does not exist. */
+  event(name) { return this._driver.event(name); }
   /** Frees the module's memory for this character. */
   dispose() { this._driver.dispose(); }
 }

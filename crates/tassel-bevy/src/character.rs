@@ -123,6 +123,17 @@ impl TasselCharacter {
         self.sim.as_ref()
     }
 
+    /// The character's own simulation, to steer at run time: external forces
+    /// ([`CharacterSim::set_external_force`], [`CharacterSim::enable_external_force`], a
+    /// force written in Rust with [`CharacterSim::set_custom_force`]), chain alphas, and
+    /// animation events ([`CharacterSim::apply_events`] with a state machine's
+    /// `BlendPlan::events`). `None` in a crowd: spawn with
+    /// [`SecondaryMotion::without_crowd`] to steer one character of a crowdable kind (a
+    /// rig file with external forces never steps in a crowd).
+    pub fn sim_mut(&mut self) -> Option<&mut CharacterSim> {
+        self.sim.as_mut()
+    }
+
     /// The compiled kind of character: skeleton, solvers, simulated joints.
     pub fn rig(&self) -> &Arc<CharacterRig> {
         &self.rig

@@ -40,6 +40,9 @@ pub fn run(a: Args) -> Result<(), String> {
     let c = builtin::character();
     let sk = &c.skeleton;
     let mut sim = CharacterSim::new(sk.clone(), &c.rig).map_err(|e| e.to_string())?;
+    // A gust on the platform: an external force the run's events switch on and off.
+    sim.set_external_force(&tassel::builtin::level::gust())
+        .map_err(|e| e.to_string())?;
     let mut run = LevelRun::new().map_err(|e| e.to_string())?;
     let dt = 1.0 / a.fps;
     let frames = (LevelRun::DURATION * a.fps).round() as usize;
@@ -160,6 +163,11 @@ pub fn run(a: Args) -> Result<(), String> {
         }
         // The door and the platform moved: the secondary motion sees this frame's level.
         sim.set_level(Some(run.level.clone()));
+        for (at, event) in tassel::builtin::level::GUST_EVENTS {
+            if f == (at * a.fps).round() as usize {
+                sim.apply_event(event).map_err(|e| e.to_string())?;
+            }
+        }
         let start = Instant::now();
         sim.frame(&locals, m.component, if f == 0 { 0.0 } else { dt })
             .map_err(|e| e.to_string())?;
@@ -445,6 +453,8 @@ pub fn run(a: Args) -> Result<(), String> {
         sim.cloth_state().reset_count()
     );
     say!("  states: {} ({events} events)", visited.join(" > "));
+    let [(on, _), (off, _)] = tassel::builtin::level::GUST_EVENTS;
+    say!("  gust: {on:.1}–{off:.1} s on the platform (an external force, switched by events)");
     say!(
         "  wrote {} ({} bytes), {} ({} bytes) and its rig, {}",
         glb_path.display(),

@@ -126,6 +126,18 @@ void tassel_reset(TasselCharacter *c);
 // `c` is NULL or a live character.
 void tassel_teleport(TasselCharacter *c);
 
+// Acts on an animation event (a NUL-terminated UTF-8 string) as KawaiiPhysics' anim
+// notifies do: `tassel:reset_dynamics`, `tassel:set_alpha 0.3 [chain]`,
+// `tassel:enable_force NAME`, `tassel:disable_force NAME`, `tassel:force_once NAME` (the
+// forces of the rig file's `[[external_force]]`). Returns 1 when it acted, 0 for an event
+// that does not start with `tassel:` (the game's own), -1 on error (a malformed event, a
+// force or chain that does not exist, NULL; `tassel_last_error` says which).
+//
+// # Safety
+// `c` is NULL or a live character; `event` is NULL or a NUL-terminated string.
+int32_t tassel_event(TasselCharacter *c,
+                     const char *event);
+
 // How many joints a solver writes (the others' output is their input). 0 for NULL.
 //
 // # Safety

@@ -360,6 +360,26 @@ pub unsafe extern "C" fn tassel_teleport(c: *mut TasselCharacter) {
     })
 }
 
+/// Acts on an animation event (a NUL-terminated UTF-8 string) as KawaiiPhysics' anim
+/// notifies do: `tassel:reset_dynamics`, `tassel:set_alpha 0.3 [chain]`,
+/// `tassel:enable_force NAME`, `tassel:disable_force NAME`, `tassel:force_once NAME` (the
+/// forces of the rig file's `[[external_force]]`). Returns 1 when it acted, 0 for an event
+/// that does not start with `tassel:` (the game's own), -1 on error (a malformed event, a
+/// force or chain that does not exist, NULL; `tassel_last_error` says which).
+///
+/// # Safety
+/// `c` is NULL or a live character; `event` is NULL or a NUL-terminated string.
+#[no_mangle]
+pub unsafe extern "C" fn tassel_event(c: *mut TasselCharacter, event: *const c_char) -> i32 {
+    guard("tassel_event", -1, || {
+        // SAFETY: the caller's promise.
+        let event = unsafe { opt_str(event, "the event") }?.ok_or("the event is NULL")?;
+        // SAFETY: the caller's promise.
+        let acted = unsafe { character_mut(c) }?.flat.apply_event(event)?;
+        Ok(i32::from(acted))
+    })
+}
+
 /// How many joints a solver writes (the others' output is their input). 0 for NULL.
 ///
 /// # Safety

@@ -224,6 +224,14 @@ impl FlatCharacter {
         self.sim.reset();
     }
 
+    /// Acts on an animation event starting with `tassel:` (see
+    /// [`CharacterSim::apply_event`]: reset the dynamics, set a chain alpha, turn an
+    /// external force of the rig on or off or apply it once): `Ok(true)` when it acted,
+    /// `Ok(false)` for an event that is not Tassel's, an error naming a bad one.
+    pub fn apply_event(&mut self, event: &str) -> Result<bool, String> {
+        self.sim.apply_event(event).map_err(|e| e.to_string())
+    }
+
     /// The solvers, for Rust callers who want more than the flat API (chain tips, VRM
     /// tails, the output in model space).
     pub fn sim(&self) -> &CharacterSim {

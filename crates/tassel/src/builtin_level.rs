@@ -237,6 +237,32 @@ const INPUT: [(f32, f32, f32, &str); 8] = [
     (17.9, 0.0, 0.0, "idle"),
 ];
 
+/// The demo's gust while the character rides the platform: a `curve` external force in
+/// world space (across the platform and a little forward), rising for 0.9 s and dying
+/// away by 1.6 s, on every chain; off until [`GUST_EVENTS`] turn it on.
+pub fn gust() -> crate::dynamics::chain::ExternalForceSettings {
+    use crate::dynamics::chain::{ExternalForceSettings, ForceKind};
+    ExternalForceSettings {
+        name: "gust".into(),
+        kind: ForceKind::Curve,
+        enabled: false,
+        force_curve: vec![
+            [0.0, 0.0, 0.0, 0.0],
+            [0.9, 0.35, 0.05, 0.12],
+            [1.6, 0.0, 0.0, 0.0],
+        ],
+        random_force_scale_range: [0.8, 1.2],
+        seed: 15,
+        ..Default::default()
+    }
+}
+
+/// When the demo's animation events turn the gust on and off (seconds, event).
+pub const GUST_EVENTS: [(f32, &str); 2] = [
+    (15.4, "tassel:enable_force gust"),
+    (17.0, "tassel:disable_force gust"),
+];
+
 /// The jump button is pressed at this time (while running).
 const JUMP_AT: f32 = 6.3;
 /// Take-off speed, m/s (apex v²/2g ≈ 0.8 m).

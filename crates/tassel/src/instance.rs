@@ -17,6 +17,9 @@ use crate::skeleton::Skeleton;
 use glam::Vec3;
 use std::sync::Arc;
 
+mod control;
+pub use control::EVENT_PREFIX;
+
 /// A character ready to simulate: a shared compiled [`CharacterRig`], this character's
 /// solver states and its last pose.
 ///

@@ -81,7 +81,7 @@ pub use error::{Error, Result};
 /// The math library Tassel's API speaks (glam 0.32), re-exported so a user needs no
 /// second, possibly different, version.
 pub use glam;
-pub use instance::CharacterSim;
+pub use instance::{CharacterSim, EVENT_PREFIX};
 pub use math::Transform;
 pub use pose::{CrowdPose, LocalToModelJob, ModelToLocalJob, Pose};
 pub use skeleton::{Skeleton, SkeletonBuilder, MAX_JOINTS, NO_PARENT};

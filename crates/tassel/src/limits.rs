@@ -49,3 +49,6 @@ pub const MAX_BONE_CONSTRAINTS: usize = 1 << 16;
 /// The most bone-constraint solves (constraints × iterations before and after collision)
 /// a character's chains run per step.
 pub const MAX_CONSTRAINT_SOLVES: usize = 1 << 20;
+
+/// The most external forces (`[[external_force]]` tables) one rig may define.
+pub const MAX_EXTERNAL_FORCES: usize = 256;

@@ -315,6 +315,7 @@ fn chain_crowd_removes_and_adds_characters() {
         speed: 0.01,
         gust: 0.5,
         seed: 11,
+        ..Default::default()
     };
     settings.chains[2].target_framerate = 90.0;
     let rig = Arc::new(ChainRig::new(&sk, &settings).unwrap());

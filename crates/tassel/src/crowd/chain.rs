@@ -74,10 +74,11 @@ impl ChainCrowd {
                 got: rig.joint_count(),
             });
         }
-        if rig.has_bone_constraints() || rig.has_sync_bones() {
+        if rig.needs_per_character() {
             return Err(Error::InvalidParameter(
-                "a chain crowd cannot step bone constraints or sync bones: run such \
-                 characters through CharacterSim"
+                "a chain crowd cannot step bone constraints, sync bones, external forces, \
+                 a simulation space other than the character's, a move scale or a noisy \
+                 wind: run such characters through CharacterSim"
                     .into(),
             ));
         }

@@ -35,15 +35,14 @@ impl CrowdKind {
     /// Which crowd steps characters of `rig` as [`crate::CharacterSim::from_rig`] would,
     /// bit for bit (a crowd has no level: a `CharacterSim` given one with
     /// [`crate::CharacterSim::set_level`] differs where chains collide with it); `None`
-    /// when the kind has springs, cloths or ropes, several kinds of solver, bone
-    /// constraints or sync bones (their chains step per character: [`ChainCrowd`] has no
-    /// lane step for them).
+    /// when the kind has springs, cloths or ropes, several kinds of solver, or chains
+    /// that need the per-character step ([`crate::dynamics::chain::ChainRig::needs_per_character`]:
+    /// [`ChainCrowd`] has no lane step for them).
     pub fn of(rig: &CharacterRig) -> Option<CrowdKind> {
         let others = !rig.springs.is_empty()
             || !rig.cloths.is_empty()
             || !rig.ropes.is_empty()
-            || rig.chains.has_bone_constraints()
-            || rig.chains.has_sync_bones();
+            || rig.chains.needs_per_character();
         let (vrm, chains) = (!rig.vrm.links.is_empty(), rig.chains.chain_count() > 0);
         match (others, vrm, chains) {
             (false, true, false) => Some(CrowdKind::Vrm),

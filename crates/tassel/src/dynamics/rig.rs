@@ -123,6 +123,14 @@ pub struct RigSettings {
     /// KawaiiPhysics' sync bones).
     #[serde(default, rename = "sync_bone", skip_serializing_if = "Vec::is_empty")]
     pub sync_bones: Vec<SyncBoneSettings>,
+    /// Forces on chain bones (`[[external_force]]` tables; KawaiiPhysics' external forces:
+    /// `basic`, `curve` and `gravity`).
+    #[serde(
+        default,
+        rename = "external_force",
+        skip_serializing_if = "Vec::is_empty"
+    )]
+    pub external_forces: Vec<crate::dynamics::chain::ExternalForceSettings>,
 }
 
 fn one() -> u32 {
@@ -147,6 +155,7 @@ impl Default for RigSettings {
             ropes: Vec::new(),
             bone_constraints: Vec::new(),
             sync_bones: Vec::new(),
+            external_forces: Vec::new(),
         }
     }
 }
@@ -244,6 +253,9 @@ impl RigSettings {
         for (i, s) in self.sync_bones.iter().enumerate() {
             s.validate(i + 1)?;
         }
+        for f in &self.external_forces {
+            f.validate()?;
+        }
         for r in &self.ropes {
             r.validate()?;
             known(&format!("rope '{}'", r.name), &r.colliders)?;
@@ -307,6 +319,22 @@ impl RigSettings {
             need(format!("chain '{}' root", c.name), &c.root)?;
             for e in &c.exclude {
                 need(format!("chain '{}' exclude", c.name), e)?;
+            }
+            if !c.simulation_base_bone.is_empty() {
+                let what = format!("chain '{}' simulation_base_bone", c.name);
+                need(what.clone(), &c.simulation_base_bone)?;
+                let (base, root) = (
+                    skeleton.find(&c.simulation_base_bone),
+                    skeleton.find(&c.root),
+                );
+                if let (Some(base), Some(root)) = (base, root) {
+                    if base == root || !skeleton.is_descendant_of(root, base) {
+                        return Err(Error::InvalidParameter(format!(
+                            "{what} '{}' is not an ancestor of its root '{}'",
+                            c.simulation_base_bone, c.root
+                        )));
+                    }
+                }
             }
         }
         for col in &self.colliders {

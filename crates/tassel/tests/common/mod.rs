@@ -165,6 +165,7 @@ pub fn chain_feature(ch: &mut tassel::dynamics::chain::ChainSettings, feature: u
                 speed: 0.01,
                 gust: 0.5,
                 seed,
+                ..Default::default()
             }
         }
         1 => ch.limit_angle = 0.2,
@@ -194,6 +195,7 @@ pub fn chain_feature(ch: &mut tassel::dynamics::chain::ChainSettings, feature: u
                 speed: 0.02,
                 gust: 1.0,
                 seed: seed + 3,
+                ..Default::default()
             };
         }
         _ => {

@@ -29,6 +29,19 @@ pub(crate) struct CompiledChain {
     pub settings: ChainSettings,
     pub points: Range<usize>,
     pub colliders: Vec<usize>,
+    /// `simulation_space = "base_bone"`: the base bone's joint.
+    pub base: Option<usize>,
+}
+
+impl CompiledChain {
+    /// Whether the chain's settings ask for what only the scalar step does: a simulation
+    /// space other than the character's, a move scale, a noisy wind.
+    pub(crate) fn scalar_only(&self) -> bool {
+        let s = &self.settings;
+        s.simulation_space != super::SimulationSpace::Component
+            || s.skel_comp_move_scale != glam::Vec3::ONE
+            || s.wind.direction_noise_angle > 0.0
+    }
 }
 
 /// Chains and colliders compiled against one skeleton. Immutable; share it between every
@@ -63,6 +76,11 @@ pub struct ChainRig {
     /// Sync bones, and per chain whether one moves its targets.
     pub(crate) syncs: Vec<super::sync::CompiledSync>,
     pub(crate) synced_chain: Vec<bool>,
+    /// Per point: its rest distance from its chain's root over the chain's longest (the
+    /// parameter curves' x; KawaiiPhysics' `LengthRateFromRoot`).
+    pub(crate) length_rate: Vec<f32>,
+    /// The rig file's external forces.
+    pub(crate) forces: Vec<std::sync::Arc<super::force::CompiledForce>>,
     pub(crate) joint_count: usize,
 }
 
@@ -115,6 +133,8 @@ impl ChainRig {
             constraints: Constraints::default(),
             syncs: Vec::new(),
             synced_chain: Vec::new(),
+            length_rate: Vec::new(),
+            forces: Vec::new(),
             joint_count: skeleton.len(),
         };
         // Every point's rest length from its chain's root.
@@ -200,6 +220,7 @@ impl ChainRig {
             let curves = &settings.curves;
             for &d in &rest_dist {
                 let x = d / max_dist;
+                out.length_rate.push(x);
                 out.damping
                     .push((settings.damping * curves.damping.eval(x)).clamp(0.0, 1.0));
                 out.stiffness
@@ -230,10 +251,14 @@ impl ChainRig {
                     crate::limits::MAX_COLLIDER_PAIRS
                 )));
             }
+            let base = (settings.simulation_space == super::SimulationSpace::BaseBone)
+                .then(|| skeleton.find(&settings.simulation_base_bone))
+                .flatten();
             out.chains.push(CompiledChain {
                 settings: settings.clone(),
                 points: start..end,
                 colliders,
+                base,
             });
         }
         // Rotators, in joint order so parents are written before children.
@@ -269,6 +294,23 @@ impl ChainRig {
         out.synced_chain = vec![false; out.chains.len()];
         for &(p, _) in out.syncs.iter().flat_map(|s| &s.targets) {
             out.synced_chain[out.chain_of[p as usize] as usize] = true;
+        }
+        if rig.external_forces.len() > crate::limits::MAX_EXTERNAL_FORCES {
+            return Err(Error::InvalidParameter(format!(
+                "the rig defines {} external forces, more than the limit of {}",
+                rig.external_forces.len(),
+                crate::limits::MAX_EXTERNAL_FORCES
+            )));
+        }
+        for (i, f) in rig.external_forces.iter().enumerate() {
+            if rig.external_forces[..i].iter().any(|g| g.name == f.name) {
+                return Err(Error::InvalidParameter(format!(
+                    "two external forces are named '{}'",
+                    f.name
+                )));
+            }
+            let force = super::force::CompiledForce::new(skeleton, &out, f)?;
+            out.forces.push(std::sync::Arc::new(force));
         }
         let parents: Vec<Option<usize>> = (0..skeleton.len()).map(|j| skeleton.parent(j)).collect();
         out.lane_groups = crate::dynamics::chain::lanes::twins::plan(&parents, &out);
@@ -337,6 +379,12 @@ impl ChainRig {
         )
     }
 
+    /// Whether the rig file sets external forces (then its chains step per character, not
+    /// in a [`crate::crowd::ChainCrowd`]'s lanes).
+    pub fn has_external_forces(&self) -> bool {
+        !self.forces.is_empty()
+    }
+
     /// Whether any sync bone moves this rig's chain targets (then those chains step per
     /// character, not in a [`crate::crowd::ChainCrowd`]'s lanes).
     pub fn has_sync_bones(&self) -> bool {
@@ -346,7 +394,20 @@ impl ChainRig {
     /// Whether chain `ci` steps alone on the scalar path: bone constraints join it to
     /// others, or a sync bone moves its targets.
     pub(crate) fn steps_outside_lanes(&self, ci: usize) -> bool {
-        self.group_of(ci).is_some() || self.synced_chain.get(ci).copied().unwrap_or(false)
+        self.group_of(ci).is_some()
+            || self.synced_chain.get(ci).copied().unwrap_or(false)
+            || self.chains[ci].scalar_only()
+    }
+
+    /// Whether the rig asks for what a [`crate::crowd::ChainCrowd`] does not step: bone
+    /// constraints, sync bones, external forces, a simulation space other than the
+    /// character's, a move scale or a noisy wind (such characters step one
+    /// [`crate::CharacterSim`] each).
+    pub fn needs_per_character(&self) -> bool {
+        self.has_bone_constraints()
+            || self.has_sync_bones()
+            || self.has_external_forces()
+            || self.chains.iter().any(CompiledChain::scalar_only)
     }
 
     /// Whether any bone constraint joins this rig's chains (then its chains with

@@ -67,7 +67,21 @@ pub struct ChainState {
     /// The targets as the animation places them, before sync bones moved them (the
     /// write-back turns bones from these); empty without sync bones.
     animated: Vec<Vec3>,
+    /// External forces: the rig's and those set at run time.
+    forces: super::force::Forces,
+    /// Per chain: the alpha set at run time (multiplies the chain's `alpha`).
+    alpha: Vec<f32>,
+    /// Per chain (`base_bone` space): the base bone's model transform this frame, last
+    /// frame, and at the chain's last step.
+    base_now: Vec<Transform>,
+    base_prev: Vec<Transform>,
+    last_step_base: Vec<Transform>,
+    /// Scratch of a group's step: per chain, the motion its step reads ([`space_step`]).
+    space_in: Vec<SpaceIn>,
 }
+
+/// What one chain's step reads of the character's motion ([`space_step`]).
+type SpaceIn = (Vec3, Quat, Option<(Transform, Transform)>);
 
 impl ChainState {
     /// Fresh state for `rig`; the first frame resets it to the animated pose.
@@ -116,6 +130,12 @@ impl ChainState {
             } else {
                 vec![Vec3::ZERO; n]
             },
+            forces: super::force::Forces::new(rig),
+            alpha: vec![1.0; c],
+            base_now: vec![Transform::IDENTITY; c],
+            base_prev: vec![Transform::IDENTITY; c],
+            last_step_base: vec![Transform::IDENTITY; c],
+            space_in: vec![(Vec3::ZERO, Quat::IDENTITY, None); c],
         }
     }
 
@@ -175,6 +195,95 @@ impl ChainState {
     /// chains instead of swinging them from the old place.
     pub fn teleport(&mut self) {
         self.reset();
+    }
+
+    /// Adds an external force, or replaces the one of the same name (its clock starts
+    /// again), compiled for `rig` on `skeleton` (the rig and skeleton this state was made
+    /// for). Errors name the force and what is wrong; the forces are unchanged then.
+    pub fn set_external_force(
+        &mut self,
+        skeleton: &Skeleton,
+        rig: &ChainRig,
+        settings: &super::ExternalForceSettings,
+    ) -> Result<()> {
+        self.check_rig(rig)?;
+        let force = super::force::CompiledForce::new(skeleton, rig, settings)?;
+        self.forces.set(rig, force);
+        Ok(())
+    }
+
+    /// Adds (or replaces by name) a force written in Rust: `settings` give its name,
+    /// chains, bone filters, space, rate curve and random scale (their `kind` and
+    /// vectors are not read); `force` gives the vector per point and step.
+    pub fn set_custom_force(
+        &mut self,
+        skeleton: &Skeleton,
+        rig: &ChainRig,
+        settings: &super::ExternalForceSettings,
+        force: std::sync::Arc<dyn super::CustomForce>,
+    ) -> Result<()> {
+        self.check_rig(rig)?;
+        let force = super::force::compile_custom(skeleton, rig, settings, force)?;
+        self.forces.set(rig, force);
+        Ok(())
+    }
+
+    /// Turns the named external force on or off (it keeps its clock); false when there
+    /// is none of that name.
+    pub fn enable_external_force(&mut self, name: &str, on: bool) -> bool {
+        self.forces.enable(name, on)
+    }
+
+    /// Applies the named external force for one step of each chain it reaches, on or off
+    /// (KawaiiPhysics' one-shot forces of anim notifies); false when there is none.
+    pub fn external_force_once(&mut self, rig: &ChainRig, name: &str) -> bool {
+        self.check_rig(rig).is_ok() && self.forces.once(rig, name)
+    }
+
+    /// Removes the named external force; false when there is none.
+    pub fn remove_external_force(&mut self, name: &str) -> bool {
+        self.forces.remove(name)
+    }
+
+    /// Removes every external force, the rig file's included.
+    pub fn clear_external_forces(&mut self) {
+        self.forces.clear();
+    }
+
+    /// The external forces' names, each with whether it is on.
+    pub fn external_forces(&self) -> impl Iterator<Item = (&str, bool)> + '_ {
+        self.forces.names()
+    }
+
+    /// Sets the alpha of chain `ci` at run time, 0..=1 (multiplies its `alpha`: 0 shows
+    /// the animated pose, 1 the simulated one; the chain keeps simulating). Errors on a
+    /// chain past the last or an alpha outside 0..=1.
+    pub fn set_alpha(&mut self, ci: usize, alpha: f32) -> Result<()> {
+        if !(0.0..=1.0).contains(&alpha) {
+            return Err(Error::InvalidParameter(format!(
+                "alpha {alpha} is outside 0..=1"
+            )));
+        }
+        let n = self.alpha.len();
+        let slot = self.alpha.get_mut(ci).ok_or_else(|| {
+            Error::InvalidParameter(format!("chain {ci} does not exist ({n} chains)"))
+        })?;
+        *slot = alpha;
+        Ok(())
+    }
+
+    /// The run-time alpha of chain `ci` (1 unless set), or `None` past the last chain.
+    pub fn alpha(&self, ci: usize) -> Option<f32> {
+        self.alpha.get(ci).copied()
+    }
+
+    fn check_rig(&self, rig: &ChainRig) -> Result<()> {
+        if self.pos.len() != rig.point_count() || self.alpha.len() != rig.chains.len() {
+            return Err(Error::InvalidParameter(
+                "chain state was made for another chain rig".into(),
+            ));
+        }
+        Ok(())
     }
 
     /// The simulated point positions of the last frame's output, model space.
@@ -259,6 +368,9 @@ impl ChainJob<'_> {
             && state.colliders.len() == self.rig.colliders.len()
             && state.lanes.len() == self.rig.lane_groups.len()
             && state.lambda.len() == self.rig.constraints.list.len()
+            && state.alpha.len() == self.rig.chains.len()
+            && state.base_now.len() == self.rig.chains.len()
+            && state.forces.fits(self.rig)
             && state.animated.len()
                 == if self.rig.syncs.is_empty() {
                     0
@@ -304,7 +416,12 @@ impl ChainJob<'_> {
             models,
             level,
         } = self;
-        let lanes = state.simd != SimdUse::Scalar && !rig.lane_groups.is_empty();
+        // External forces and run-time alphas are stepped on the scalar path only (the
+        // lanes give the same bits without them).
+        let lanes = state.simd != SimdUse::Scalar
+            && !rig.lane_groups.is_empty()
+            && !state.forces.any()
+            && state.alpha.iter().all(|&a| a == 1.0);
         if lanes != state.in_lanes {
             state.move_lanes(rig, lanes);
         }
@@ -316,6 +433,12 @@ impl ChainJob<'_> {
             &mut state.normals,
             &mut state.colliders,
         );
+        state.forces.gather_bones(rig, models);
+        for (ci, chain) in rig.chains.iter().enumerate() {
+            if let Some(b) = chain.base {
+                state.base_now[ci] = models[b];
+            }
+        }
         if !rig.syncs.is_empty() {
             state.animated.copy_from_slice(&state.targets);
             // A chain that starts again this frame has no simulated points yet: its
@@ -383,6 +506,8 @@ impl ChainJob<'_> {
         state.prev_normals.copy_from_slice(&state.normals);
         state.prev_colliders.copy_from_slice(&state.colliders);
         state.prev_component = component;
+        state.forces.end_frame();
+        state.base_prev.copy_from_slice(&state.base_now);
 
         if lanes {
             for (group, lanes) in rig.lane_groups.iter().zip(&state.lanes) {
@@ -488,6 +613,8 @@ fn reset_chain(
     // own this frame, and the frame's end places them for all).
     state.accumulator[ci] = 0.0;
     state.last_step_component[ci] = *component;
+    state.base_prev[ci] = state.base_now[ci];
+    state.last_step_base[ci] = state.base_now[ci];
     let s = &rig.chains[ci].settings;
     let h = 1.0 / s.target_framerate;
     state.dt_old[ci] = h;
@@ -506,6 +633,9 @@ fn reset_chain(
             dt_old: h,
             fixed: s.mode == TimeMode::Fixed,
             world: None,
+            push: &[],
+            accel: &[],
+            base: None,
         };
         step_chain(
             rig,
@@ -533,6 +663,50 @@ pub(crate) fn gravity_cs(s: &super::ChainSettings, component: &Transform) -> Vec
 
 pub(crate) fn wind_cs(s: &super::ChainSettings, component: &Transform) -> Vec3 {
     component.rotation.inverse() * normalize_or(s.wind.direction, Vec3::ZERO)
+}
+
+/// Carries chain `ci`'s points into its simulation space for a step over which the
+/// character moves `from → to` (world transforms), and returns what the step reads of the
+/// character's motion: `component` space, the motion as inertia (its translation scaled by
+/// `skel_comp_move_scale`); `world` space, nothing (the points were carried to keep their
+/// world place); `base_bone` space, the points carried with the base bone from its last
+/// step's transform to `base_to`, then the motion as in `component`, with both base
+/// transforms (the turn acts on where the points were).
+fn space_step(
+    rig: &ChainRig,
+    ci: usize,
+    pos: &mut [Vec3],
+    prev: &mut [Vec3],
+    (from, to): (&Transform, &Transform),
+    base_to: Transform,
+    last_base: &mut Transform,
+) -> SpaceIn {
+    let chain = &rig.chains[ci];
+    let s = &chain.settings;
+    let (move_cs, rotate_cs) = motion_cs(from, to);
+    match s.simulation_space {
+        super::SimulationSpace::Component => (move_cs * s.skel_comp_move_scale, rotate_cs, None),
+        super::SimulationSpace::World => {
+            for p in chain.points.clone() {
+                pos[p] = rotate_cs * pos[p] + move_cs;
+                prev[p] = rotate_cs * prev[p] + move_cs;
+            }
+            (Vec3::ZERO, Quat::IDENTITY, None)
+        }
+        super::SimulationSpace::BaseBone => {
+            let from_base = *last_base;
+            for p in chain.points.clone() {
+                pos[p] = base_to.transform_point(from_base.inverse_transform_point(pos[p]));
+                prev[p] = base_to.transform_point(from_base.inverse_transform_point(prev[p]));
+            }
+            *last_base = base_to;
+            (
+                move_cs * s.skel_comp_move_scale,
+                rotate_cs,
+                Some((from_base, base_to)),
+            )
+        }
+    }
 }
 
 /// Character motion from `a` to `b`, as seen from `b`'s space.
@@ -628,8 +802,26 @@ fn run_chain(
         match s.mode {
             TimeMode::Classic => {
                 let dt = dt.min(s.max_delta_time);
+                // The points carried into this frame's simulation space, step or not.
+                let (move_cs, rotate_cs, base) = space_step(
+                    rig,
+                    ci,
+                    &mut state.pos,
+                    &mut state.prev,
+                    (&state.prev_component, component),
+                    state.base_now[ci],
+                    &mut state.last_step_base[ci],
+                );
                 if dt > 0.0 {
-                    let (move_cs, rotate_cs) = motion_cs(&state.prev_component, component);
+                    let forced = state.forces.prepare(
+                        rig,
+                        ci,
+                        dt,
+                        1.0,
+                        component,
+                        &state.pos,
+                        &state.targets,
+                    );
                     let world = world_for(
                         rig,
                         ci,
@@ -652,6 +844,9 @@ fn run_chain(
                         dt_old: state.dt_old[ci],
                         fixed: false,
                         world,
+                        push: if forced { &state.forces.push } else { &[] },
+                        accel: &state.forces.accel,
+                        base,
                     };
                     step_chain(
                         rig,
@@ -721,7 +916,7 @@ fn output_chain(
     .map(|w| w.level);
     for p in points {
         let t = state.targets[p];
-        let dev = state.dev_before[p].lerp(state.dev[p], w) * s.alpha;
+        let dev = state.dev_before[p].lerp(state.dev[p], w) * (s.alpha * state.alpha[ci]);
         let parent = rig.parent[p];
         state.out[p] = if parent == NONE {
             t
@@ -828,7 +1023,19 @@ fn run_fixed(rig: &ChainRig, ci: usize, state: &mut ChainState, dt: f32, level: 
         let w = step_end(k, h, acc_old, skipped, dt);
         place_step(rig, ci, state, w);
         let comp_b = state.path.at(w);
-        let (move_cs, rotate_cs) = motion_cs(&state.last_step_component[ci], &comp_b);
+        let base_b = state.base_prev[ci].lerp(&state.base_now[ci], w);
+        let (move_cs, rotate_cs, base) = space_step(
+            rig,
+            ci,
+            &mut state.pos,
+            &mut state.prev,
+            (&state.last_step_component[ci], &comp_b),
+            base_b,
+            &mut state.last_step_base[ci],
+        );
+        let forced = state
+            .forces
+            .prepare(rig, ci, h, w, &comp_b, &state.pos, &state.step_targets);
         let world = world_for(
             rig,
             ci,
@@ -851,6 +1058,9 @@ fn run_fixed(rig: &ChainRig, ci: usize, state: &mut ChainState, dt: f32, level: 
             dt_old: h,
             fixed: true,
             world,
+            push: if forced { &state.forces.push } else { &[] },
+            accel: &state.forces.accel,
+            base,
         };
         step_chain(
             rig,
@@ -898,6 +1108,18 @@ fn run_group(
         match s.mode {
             TimeMode::Classic => {
                 let dt = dt.min(s.max_delta_time);
+                // The points carried into this frame's simulation space, step or not.
+                for &ci in &group.chains {
+                    state.space_in[ci] = space_step(
+                        rig,
+                        ci,
+                        &mut state.pos,
+                        &mut state.prev,
+                        (&state.prev_component, component),
+                        state.base_now[ci],
+                        &mut state.last_step_base[ci],
+                    );
+                }
                 if dt > 0.0 {
                     let from = state.prev_component;
                     for &ci in &group.chains {
@@ -905,7 +1127,17 @@ fn run_group(
                             world_for(rig, ci, level, &state.pos, &state.targets, &from, component)
                                 .is_some();
                     }
-                    let (move_cs, rotate_cs) = motion_cs(&from, component);
+                    for &ci in &group.chains {
+                        state.forces.prepare(
+                            rig,
+                            ci,
+                            dt,
+                            1.0,
+                            component,
+                            &state.pos,
+                            &state.targets,
+                        );
+                    }
                     let ChainState {
                         pos,
                         prev,
@@ -917,10 +1149,14 @@ fn run_group(
                         bounds,
                         dt_old,
                         world_near,
+                        forces,
+                        space_in,
                         ..
                     } = &mut *state;
+                    let forces = &*forces;
                     let input_of = |ci: usize| {
                         let s = &rig.chains[ci].settings;
+                        let (move_cs, rotate_cs, base) = space_in[ci];
                         StepInput {
                             targets,
                             normals,
@@ -938,6 +1174,13 @@ fn run_group(
                                 from,
                                 to: *component,
                             }),
+                            push: if forces.reaches(ci) {
+                                &forces.push
+                            } else {
+                                &[]
+                            },
+                            accel: &forces.accel,
+                            base,
                         }
                     };
                     step_group(rig, group, &input_of, pos, prev, rng, lambda);
@@ -1004,6 +1247,9 @@ fn reset_group(rig: &ChainRig, group: &ChainGroup, state: &mut ChainState, compo
                 dt_old: h,
                 fixed,
                 world: None,
+                push: &[],
+                accel: &[],
+                base: None,
             }
         };
         for _ in 0..s.warmup_steps {
@@ -1051,7 +1297,21 @@ fn run_fixed_group(
             )
             .is_some();
         }
-        let (move_cs, rotate_cs) = motion_cs(&from, &comp_b);
+        for &ci in &group.chains {
+            let base_b = state.base_prev[ci].lerp(&state.base_now[ci], w);
+            state.space_in[ci] = space_step(
+                rig,
+                ci,
+                &mut state.pos,
+                &mut state.prev,
+                (&from, &comp_b),
+                base_b,
+                &mut state.last_step_base[ci],
+            );
+            state
+                .forces
+                .prepare(rig, ci, h, w, &comp_b, &state.pos, &state.step_targets);
+        }
         {
             let ChainState {
                 pos,
@@ -1063,10 +1323,14 @@ fn run_fixed_group(
                 step_colliders,
                 step_bounds,
                 world_near,
+                forces,
+                space_in,
                 ..
             } = &mut *state;
+            let forces = &*forces;
             let input_of = |ci: usize| {
                 let s = &rig.chains[ci].settings;
+                let (move_cs, rotate_cs, base) = space_in[ci];
                 StepInput {
                     targets: step_targets,
                     normals: step_normals,
@@ -1084,6 +1348,13 @@ fn run_fixed_group(
                         from,
                         to: comp_b,
                     }),
+                    push: if forces.reaches(ci) {
+                        &forces.push
+                    } else {
+                        &[]
+                    },
+                    accel: &forces.accel,
+                    base,
                 }
             };
             step_group(rig, group, &input_of, pos, prev, rng, lambda);

@@ -8,6 +8,7 @@
 
 pub(crate) mod compile;
 pub(crate) mod constraint;
+pub(crate) mod force;
 pub(crate) mod job;
 pub(crate) mod lanes;
 mod settings;
@@ -16,6 +17,11 @@ pub(crate) mod sync;
 
 pub use compile::{ChainRig, PointInfo};
 pub use constraint::{BoneConstraintOptions, BoneConstraintSettings, Compliance, CompliancePreset};
+pub use force::{
+    CurveEvaluate, CustomForce, ExternalForceSettings, ForceKind, ForcePoint, ForceSpace, ForceStep,
+};
 pub use job::{ChainJob, ChainState};
-pub use settings::{ChainCurves, ChainSettings, ClassicGravity, PlanarAxis, TimeMode, Wind};
+pub use settings::{
+    ChainCurves, ChainSettings, ClassicGravity, PlanarAxis, SimulationSpace, TimeMode, Wind,
+};
 pub use sync::{SyncBoneSettings, SyncDirection, SyncTargetSettings};

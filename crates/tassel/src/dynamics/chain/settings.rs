@@ -61,6 +61,27 @@ impl PlanarAxis {
     }
 }
 
+/// The space a chain simulates in (KawaiiPhysics 1.19's `SimulationSpace`): what the
+/// points keep still while nothing pulls them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SimulationSpace {
+    /// The character's space: its motion reaches the points as inertia, scaled by
+    /// `world_damping_location` / `_rotation` and `skel_comp_move_scale`.
+    #[default]
+    #[serde(alias = "component_space")]
+    Component,
+    /// World space: the points keep their place in the world while the character moves
+    /// (full inertia; the world damping keys are not read).
+    #[serde(alias = "world_space")]
+    World,
+    /// A bone's space (`simulation_base_bone`, an ancestor of the chain's root): the
+    /// points ride with that bone's animated motion (a dancing pelvis does not whip the
+    /// skirt); the character's motion reaches them as in `component`.
+    #[serde(alias = "base_bone_space")]
+    BaseBone,
+}
+
 /// Wind: a push along a world direction with seeded random gusts.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -74,6 +95,22 @@ pub struct Wind {
     pub gust: f32,
     /// Seed of the gust generator.
     pub seed: u64,
+    /// Each point and step turns the wind by a random angle up to this, degrees, 0..=180
+    /// (KawaiiPhysics' `WindDirectionNoiseAngle`; 0: none).
+    #[serde(skip_serializing_if = "is_zero")]
+    pub direction_noise_angle: f32,
+}
+
+fn is_zero(v: &f32) -> bool {
+    *v == 0.0
+}
+
+fn is_one(v: &Vec3) -> bool {
+    *v == Vec3::ONE
+}
+
+fn is_component(v: &SimulationSpace) -> bool {
+    *v == SimulationSpace::Component
 }
 
 impl Default for Wind {
@@ -83,6 +120,7 @@ impl Default for Wind {
             speed: 0.0,
             gust: 1.0,
             seed: 1,
+            direction_noise_angle: 0.0,
         }
     }
 }
@@ -166,6 +204,17 @@ pub struct ChainSettings {
     pub max_steps_per_frame: u32,
     /// `classic` mode: a longer frame is clamped to this, seconds.
     pub max_delta_time: f32,
+    /// The space the chain simulates in.
+    #[serde(skip_serializing_if = "is_component")]
+    pub simulation_space: SimulationSpace,
+    /// `simulation_space = "base_bone"`: the bone whose space it is (an ancestor of `root`).
+    #[serde(skip_serializing_if = "String::is_empty")]
+    pub simulation_base_bone: String,
+    /// Per character axis, the share of the character's translation that reaches the
+    /// points as inertia (KawaiiPhysics' `SkelCompMoveScale`; 0..=10 each, `[1, 1, 1]`:
+    /// all; `[1, 0, 1]`: a jump does not lift the hair).
+    #[serde(skip_serializing_if = "is_one")]
+    pub skel_comp_move_scale: Vec3,
 }
 
 impl Default for ChainSettings {
@@ -197,6 +246,9 @@ impl Default for ChainSettings {
             world_collision: false,
             max_steps_per_frame: 10,
             max_delta_time: 0.1,
+            simulation_space: SimulationSpace::Component,
+            simulation_base_bone: String::new(),
+            skel_comp_move_scale: Vec3::ONE,
         }
     }
 }
@@ -266,6 +318,30 @@ impl ChainSettings {
         }
         if !self.gravity.is_finite() {
             return bad(format!("gravity {} is not finite", self.gravity));
+        }
+        if !(0.0..=180.0).contains(&self.wind.direction_noise_angle) {
+            return bad(format!(
+                "wind.direction_noise_angle is {}; it must be 0..=180 degrees",
+                self.wind.direction_noise_angle
+            ));
+        }
+        let m = self.skel_comp_move_scale;
+        if !(m.is_finite() && m.min_element() >= 0.0 && m.max_element() <= 10.0) {
+            return bad(format!(
+                "skel_comp_move_scale {m} must be 0..=10 on each axis"
+            ));
+        }
+        match (self.simulation_space, self.simulation_base_bone.is_empty()) {
+            (SimulationSpace::BaseBone, true) => {
+                return bad("simulation_space = \"base_bone\" needs simulation_base_bone".into())
+            }
+            (SimulationSpace::Component | SimulationSpace::World, false) => {
+                return bad(format!(
+                    "simulation_base_bone '{}' is set but simulation_space is not \"base_bone\"",
+                    self.simulation_base_bone
+                ))
+            }
+            _ => {}
         }
         if !self.wind.direction.is_finite() {
             return bad(format!(

@@ -33,6 +33,15 @@ pub(crate) struct StepInput<'a> {
     pub fixed: bool,
     /// The world, when the chain collides with it and geometry is near.
     pub world: Option<crate::dynamics::world::WorldContact<'a>>,
+    /// External forces this step, per point (empty: none act on the chain): the push
+    /// (`x += push × dt`, after inertia, before the pull) and the acceleration
+    /// (`v += accel × dt`, before the point moves).
+    pub push: &'a [Vec3],
+    pub accel: &'a [Vec3],
+    /// `base_bone` space: the base bone's transforms at the last step and at this one.
+    /// The points were carried from the first to the second; the character's turn acts
+    /// on where they were (KawaiiPhysics' follow-rotation in base-bone space).
+    pub base: Option<(crate::math::Transform, crate::math::Transform)>,
 }
 
 /// What one step of a chain uses for every point.
@@ -40,6 +49,8 @@ struct ChainStep {
     exponent: f32,
     gravity_step: Vec3,
     wind_on: bool,
+    /// The wind's direction noise, radians (0: none).
+    wind_noise: f32,
 }
 
 impl ChainStep {
@@ -48,6 +59,7 @@ impl ChainStep {
             exponent: s.target_framerate * input.dt,
             gravity_step: gravity_step(s, input.gravity_cs, input.dt, input.fixed),
             wind_on: s.wind.speed > 0.0 && input.wind_cs != Vec3::ZERO,
+            wind_noise: s.wind.direction_noise_angle.to_radians(),
         }
     }
 }
@@ -79,14 +91,30 @@ fn advance(
     velocity *= 1.0 - rig.damping[p];
     if k.wind_on {
         let gust = rng.range_f32(1.0 - s.wind.gust, 1.0 + s.wind.gust);
-        velocity += input.wind_cs * s.wind.speed * gust * s.target_framerate;
+        let dir = if k.wind_noise > 0.0 {
+            noisy(input.wind_cs, k.wind_noise, rng)
+        } else {
+            input.wind_cs
+        };
+        velocity += dir * s.wind.speed * gust * s.target_framerate;
+    }
+    let forced = !input.push.is_empty();
+    if forced {
+        velocity += input.accel[p] * input.dt;
     }
     let mut x = pos[p] + velocity * input.dt;
 
     // Inertia: follow the character's translation and rotation only partly.
     x += input.move_cs * (1.0 - rig.wd_location[p]);
-    x += (input.rotate_cs * prev[p] - prev[p]) * (1.0 - rig.wd_rotation[p]);
+    let before = match &input.base {
+        Some((from, to)) => from.transform_point(to.inverse_transform_point(prev[p])),
+        None => prev[p],
+    };
+    x += (input.rotate_cs * before - prev[p]) * (1.0 - rig.wd_rotation[p]);
     x += k.gravity_step;
+    if forced {
+        x += input.push[p] * input.dt;
+    }
 
     // Pull toward the animated pose, relative to the simulated parent.
     let base = pos[pp] + (t[p] - t[pp]);
@@ -334,6 +362,16 @@ pub(crate) fn step_group<'a>(
     }
 }
 
+/// A unit direction drawn uniformly from the cone of half-angle `angle` radians about
+/// unit `dir` (KawaiiPhysics' `FMath::VRandCone`).
+pub(crate) fn noisy(dir: Vec3, angle: f32, rng: &mut SplitMix64) -> Vec3 {
+    let cos_t = 1.0 - rng.range_f32(0.0, 1.0) * (1.0 - angle.cos());
+    let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
+    let phi = rng.range_f32(0.0, std::f32::consts::TAU);
+    let (u, v) = dir.any_orthonormal_pair();
+    dir * cos_t + (u * phi.cos() + v * phi.sin()) * sin_t
+}
+
 /// Gravity's share of one step of `dt` for the chain's time mode (fixed: an acceleration;
 /// classic: the chain's rule).
 pub(crate) fn gravity_step(s: &ChainSettings, g: Vec3, dt: f32, fixed: bool) -> Vec3 {
@@ -368,5 +406,42 @@ pub(crate) fn cone_limit(x: Vec3, parent: Vec3, anim_dir: Vec3, limit: f32) -> V
         parent + dir * d.length()
     } else {
         x
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Directions from `noisy` stay within the cone, spread over it (uniform on the cap:
+    /// the mean cosine is halfway between 1 and cos α), and are unit.
+    #[test]
+    fn noisy_wind_stays_in_its_cone_and_fills_it() {
+        let mut rng = SplitMix64::new(3);
+        let axis = Vec3::new(1.0, 2.0, -0.5).normalize();
+        for degrees in [5.0f32, 30.0, 90.0, 180.0] {
+            let angle = degrees.to_radians();
+            let (mut widest, mut sum_cos) = (0.0f32, 0.0f64);
+            let n = 20_000;
+            for _ in 0..n {
+                let d = noisy(axis, angle, &mut rng);
+                assert!((d.length() - 1.0).abs() < 1e-5);
+                let a = d.dot(axis).clamp(-1.0, 1.0).acos();
+                assert!(a <= angle + 1e-3, "{degrees}°: {}°", a.to_degrees());
+                widest = widest.max(a);
+                sum_cos += d.dot(axis) as f64;
+            }
+            assert!(
+                widest > 0.97 * angle,
+                "{degrees}°: widest {}°",
+                widest.to_degrees()
+            );
+            let want = 0.5 * (1.0 + angle.cos() as f64);
+            let mean = sum_cos / n as f64;
+            assert!(
+                (mean - want).abs() < 0.01,
+                "{degrees}°: mean cos {mean}, uniform {want}"
+            );
+        }
     }
 }

@@ -1,0 +1,115 @@
+//! Animation events through the flat API and the C ABI (`tassel_event`): a force of the
+//! rig file switched on by `tassel:enable_force` acts as the same force on from the
+//! start, bit for bit; the game's own events pass; a bad one is -1 with an error that
+//! names it.
+
+use std::ffi::{CStr, CString};
+use tassel_ffi::abi::{
+    tassel_character_free, tassel_character_load, tassel_event, tassel_frame, tassel_last_error,
+};
+use tassel_ffi::{FlatCharacter, FLOATS_PER_JOINT};
+
+const F: usize = FLOATS_PER_JOINT;
+
+/// The built-in character's chains as a GLB and a rig file with a gust on (`on`) or off.
+fn builtin_with_gust(on: bool) -> (Vec<u8>, String) {
+    let c = tassel::builtin::character();
+    let source = tassel_gltf::ExportSource::from_skeleton(&c.skeleton, tassel_gltf::BoneMesh::None);
+    let glb = tassel_gltf::export_glb(&source, &[]).unwrap();
+    let mut rig = c.rig.clone();
+    rig.springs.clear();
+    rig.cloths.clear();
+    rig.ropes.clear();
+    let mut gust = tassel::builtin::level::gust();
+    gust.enabled = on;
+    rig.external_forces = vec![gust];
+    (glb, rig.to_toml_string().unwrap())
+}
+
+fn root(f: usize) -> [f32; F] {
+    let t = f as f32 / 60.0;
+    [
+        0.3 * (2.0 * t).sin(),
+        0.0,
+        0.0,
+        0.0,
+        0.0,
+        0.0,
+        1.0,
+        1.0,
+        1.0,
+        1.0,
+    ]
+}
+
+fn last_error() -> String {
+    // SAFETY: NULL or this thread's NUL-terminated error.
+    let p = tassel_last_error();
+    assert!(!p.is_null());
+    unsafe { CStr::from_ptr(p) }.to_string_lossy().into_owned()
+}
+
+#[test]
+fn events_switch_the_rig_files_forces_through_the_flat_api_and_the_c_abi() {
+    let (glb, on) = builtin_with_gust(true);
+    let (_, off) = builtin_with_gust(false);
+    let mut reference = FlatCharacter::load(&glb, Some(&on), None).unwrap();
+    let mut plain = FlatCharacter::load(&glb, Some(&off), None).unwrap();
+    let mut flat = FlatCharacter::load(&glb, Some(&off), None).unwrap();
+    assert!(flat.apply_event("tassel:enable_force gust").unwrap());
+    assert!(!flat.apply_event("footstep").unwrap());
+    let rig = CString::new(off).unwrap();
+    // SAFETY: the bytes and the rig outlive the call; the character is freed below.
+    let c =
+        unsafe { tassel_character_load(glb.as_ptr(), glb.len(), rig.as_ptr(), std::ptr::null()) };
+    assert!(!c.is_null(), "{}", last_error());
+    let event = |text: &str| {
+        let text = CString::new(text).unwrap();
+        // SAFETY: a live character and a NUL-terminated string.
+        unsafe { tassel_event(c, text.as_ptr()) }
+    };
+    assert_eq!(event("tassel:enable_force gust"), 1);
+    assert_eq!(event("jump_landed"), 0);
+    assert_eq!(event("tassel:enable_force breeze"), -1);
+    assert!(last_error().contains("'breeze'"), "{}", last_error());
+    assert_eq!(event("tassel:set_alpha"), -1);
+    assert!(
+        last_error().contains("tassel:set_alpha"),
+        "{}",
+        last_error()
+    );
+    // SAFETY: NULL is refused with an error, never read.
+    assert_eq!(unsafe { tassel_event(c, std::ptr::null()) }, -1);
+
+    let n = reference.joint_count() * F;
+    let mut rest = vec![0.0; n];
+    reference.rest_locals(&mut rest).unwrap();
+    let (mut moved, mut differs) = (0.0f32, false);
+    for f in 0..90 {
+        let dt = if f == 0 { 0.0 } else { 1.0 / 60.0 };
+        let r = root(f);
+        let mut want = rest.clone();
+        reference.frame(&r, &mut want, dt).unwrap();
+        let mut got = rest.clone();
+        flat.frame(&r, &mut got, dt).unwrap();
+        let mut without = rest.clone();
+        plain.frame(&r, &mut without, dt).unwrap();
+        let mut abi = vec![0.0; n];
+        // SAFETY: buffers of `n` floats, the root of 10; no overlap.
+        let status = unsafe { tassel_frame(c, r.as_ptr(), rest.as_ptr(), abi.as_mut_ptr(), n, dt) };
+        assert_eq!(status, 0, "{}", last_error());
+        let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&got), bits(&want), "frame {f}: flat event vs rig");
+        assert_eq!(bits(&abi), bits(&want), "frame {f}: C ABI event vs rig");
+        differs |= bits(&without) != bits(&want);
+        for (a, b) in want.iter().zip(&without) {
+            moved = moved.max((a - b).abs());
+        }
+    }
+    assert!(
+        differs && moved > 1e-3,
+        "the gust moves the chains ({moved})"
+    );
+    // SAFETY: loaded above, freed once.
+    unsafe { tassel_character_free(c) };
+}

@@ -1,0 +1,181 @@
+//! A character's secondary motion steered at run time: external forces set, changed and
+//! cleared, chain alphas, and the animation events that do the same from a state
+//! machine's transitions (KawaiiPhysics' anim notifies).
+
+use super::CharacterSim;
+use crate::dynamics::chain::{CustomForce, ExternalForceSettings};
+use crate::error::{Error, Result};
+use std::sync::Arc;
+
+/// The prefix of the animation events [`CharacterSim::apply_event`] acts on.
+pub const EVENT_PREFIX: &str = "tassel:";
+
+impl CharacterSim {
+    /// Adds an external force to the chains, or replaces the one of the same name (its
+    /// clock starts again): the rig file's `[[external_force]]` at run time. Errors name
+    /// the force and the entry; the forces are unchanged then.
+    pub fn set_external_force(&mut self, settings: &ExternalForceSettings) -> Result<()> {
+        let rig = Arc::clone(&self.rig);
+        self.state
+            .set_external_force(&rig.skeleton, &rig.chains, settings)
+    }
+
+    /// Adds (or replaces by name) a force written in Rust (see [`CustomForce`]):
+    /// `settings` give its name, chains, bone filters, space, rate curve and random scale.
+    pub fn set_custom_force(
+        &mut self,
+        settings: &ExternalForceSettings,
+        force: Arc<dyn CustomForce>,
+    ) -> Result<()> {
+        let rig = Arc::clone(&self.rig);
+        self.state
+            .set_custom_force(&rig.skeleton, &rig.chains, settings, force)
+    }
+
+    /// Turns the named external force on or off; an error names a force that does not
+    /// exist.
+    pub fn enable_external_force(&mut self, name: &str, on: bool) -> Result<()> {
+        if self.state.enable_external_force(name, on) {
+            Ok(())
+        } else {
+            Err(no_force(name))
+        }
+    }
+
+    /// Applies the named external force for one step of each chain it reaches, whether
+    /// it is on or off (a one-shot push: an explosion, a landing).
+    pub fn external_force_once(&mut self, name: &str) -> Result<()> {
+        let rig = Arc::clone(&self.rig);
+        if self.state.external_force_once(&rig.chains, name) {
+            Ok(())
+        } else {
+            Err(no_force(name))
+        }
+    }
+
+    /// Removes the named external force; false when there was none.
+    pub fn remove_external_force(&mut self, name: &str) -> bool {
+        self.state.remove_external_force(name)
+    }
+
+    /// Removes every external force, the rig file's included.
+    pub fn clear_external_forces(&mut self) {
+        self.state.clear_external_forces()
+    }
+
+    /// The external forces' names, each with whether it is on.
+    pub fn external_forces(&self) -> impl Iterator<Item = (&str, bool)> + '_ {
+        self.state.external_forces()
+    }
+
+    /// Sets the run-time alpha (0..=1, multiplying each chain's `alpha`) of the named
+    /// chain, or of every chain with `None`: 0 shows the animated pose, 1 the simulated
+    /// one; the chains keep simulating underneath.
+    pub fn set_chain_alpha(&mut self, chain: Option<&str>, alpha: f32) -> Result<()> {
+        let chains = &self.rig.chains;
+        let range = match chain {
+            Some(name) => {
+                let ci = self.rig.chain_index(name).ok_or_else(|| {
+                    Error::InvalidParameter(format!("there is no chain named '{name}'"))
+                })?;
+                ci..ci + 1
+            }
+            None => 0..chains.chain_count(),
+        };
+        if !(0.0..=1.0).contains(&alpha) {
+            return Err(Error::InvalidParameter(format!(
+                "alpha {alpha} is outside 0..=1"
+            )));
+        }
+        for ci in range {
+            self.state.set_alpha(ci, alpha)?;
+        }
+        Ok(())
+    }
+
+    /// Acts on one animation event (a state machine transition's `events` entry, see
+    /// [`crate::anim::BlendPlan::events`]) that starts with `tassel:`, as KawaiiPhysics'
+    /// anim notifies do:
+    ///
+    /// | event | does |
+    /// |---|---|
+    /// | `tassel:reset_dynamics` | [`reset`](Self::reset): the next frame starts from the pose |
+    /// | `tassel:set_alpha 0.3` | [`set_chain_alpha`](Self::set_chain_alpha) of every chain |
+    /// | `tassel:set_alpha 0.3 hair` | the same for chain `hair` |
+    /// | `tassel:enable_force gust` | [`enable_external_force`](Self::enable_external_force) |
+    /// | `tassel:disable_force gust` | turns it off |
+    /// | `tassel:force_once gust` | [`external_force_once`](Self::external_force_once) |
+    ///
+    /// Returns `Ok(false)` for an event that does not start with `tassel:` (the game's
+    /// own), `Ok(true)` when it acted, and an error naming the event when it starts with
+    /// `tassel:` but is not one of these or names what does not exist.
+    ///
+    /// ```
+    /// use tassel::{builtin, CharacterSim};
+    /// let c = builtin::character();
+    /// let mut sim = CharacterSim::new(c.skeleton.clone(), &c.rig).unwrap();
+    /// assert!(sim.apply_event("tassel:set_alpha 0.5").unwrap());
+    /// assert!(!sim.apply_event("footstep").unwrap());
+    /// assert!(sim.apply_event("tassel:enable_force nothing").is_err());
+    /// ```
+    pub fn apply_event(&mut self, event: &str) -> Result<bool> {
+        let Some(rest) = event.strip_prefix(EVENT_PREFIX) else {
+            return Ok(false);
+        };
+        let bad = |why: String| Error::InvalidParameter(format!("event '{event}': {why}"));
+        let mut words = rest.split_whitespace();
+        let verb = words.next().unwrap_or("");
+        let args: Vec<&str> = words.collect();
+        let one = |args: &[&str]| match args {
+            [name] => Ok(name.to_string()),
+            _ => Err(bad("takes one force name".into())),
+        };
+        match verb {
+            "reset_dynamics" if args.is_empty() => self.reset(),
+            "set_alpha" => {
+                let (value, chain) = match args.as_slice() {
+                    [v] => (v, None),
+                    [v, chain] => (v, Some(*chain)),
+                    _ => return Err(bad("takes an alpha and, optionally, a chain name".into())),
+                };
+                let alpha: f32 = value
+                    .parse()
+                    .map_err(|_| bad(format!("'{value}' is not a number")))?;
+                self.set_chain_alpha(chain, alpha)
+                    .map_err(|e| bad(e.to_string()))?;
+            }
+            "enable_force" | "disable_force" => {
+                let name = one(&args)?;
+                self.enable_external_force(&name, verb == "enable_force")
+                    .map_err(|e| bad(e.to_string()))?;
+            }
+            "force_once" => {
+                let name = one(&args)?;
+                self.external_force_once(&name)
+                    .map_err(|e| bad(e.to_string()))?;
+            }
+            _ => {
+                return Err(bad(
+                    "not one of reset_dynamics, set_alpha, enable_force, disable_force, \
+                     force_once"
+                        .into(),
+                ))
+            }
+        }
+        Ok(true)
+    }
+
+    /// [`apply_event`](Self::apply_event) for each event in order; stops at the first
+    /// error. Returns how many were Tassel's.
+    pub fn apply_events<S: AsRef<str>>(&mut self, events: &[S]) -> Result<usize> {
+        let mut n = 0;
+        for e in events {
+            n += usize::from(self.apply_event(e.as_ref())?);
+        }
+        Ok(n)
+    }
+}
+
+fn no_force(name: &str) -> Error {
+    Error::InvalidParameter(format!("there is no external force named '{name}'"))
+}
