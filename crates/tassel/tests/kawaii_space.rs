@@ -296,7 +296,8 @@ fn classic_matches_kawaiiphysics_1_20_simulation_spaces_and_move_scale() {
                 );
                 // 2e-5 m, or within 1.5× the chain's own agreement in component space
                 // (at 144 Hz swaying the chain alone differs from this port by up to
-                // 2.6e-5 m: see kawaii_forces.rs).
+                // 2.6e-5 m: the f32 rounding of the order Tassel adds gravity in, which an
+                // f32 twin of the port in that order shows too; see kawaii_forces.rs).
                 assert!(
                     worst <= 2e-5_f64.max(1.5 * baseline),
                     "{what}, {motion} {hz} Hz: {worst} m (component space: {baseline} m)"
