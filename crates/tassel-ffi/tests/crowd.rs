@@ -14,10 +14,8 @@ const F: usize = FLOATS_PER_JOINT;
 
 /// The built-in character as a GLB and its rig file, with only the solvers `keep` lists.
 fn builtin(keep: &[&str]) -> (Vec<u8>, String) {
-    let c = tassel::builtin::character();
-    let source = tassel_gltf::ExportSource::from_skeleton(&c.skeleton, tassel_gltf::BoneMesh::None);
-    let glb = tassel_gltf::export_glb(&source, &[]).unwrap();
-    let mut rig = c.rig.clone();
+    let glb = common::builtin_glb();
+    let mut rig = tassel::builtin::character().rig;
     if !keep.contains(&"chains") {
         rig.chains.clear();
     }

@@ -3,6 +3,8 @@
 //! start, bit for bit; the game's own events pass; a bad one is -1 with an error that
 //! names it.
 
+mod common;
+
 use std::ffi::{CStr, CString};
 use tassel_ffi::abi::{
     tassel_character_free, tassel_character_load, tassel_event, tassel_frame, tassel_last_error,
@@ -13,10 +15,8 @@ const F: usize = FLOATS_PER_JOINT;
 
 /// The built-in character's chains as a GLB and a rig file with a gust on (`on`) or off.
 fn builtin_with_gust(on: bool) -> (Vec<u8>, String) {
-    let c = tassel::builtin::character();
-    let source = tassel_gltf::ExportSource::from_skeleton(&c.skeleton, tassel_gltf::BoneMesh::None);
-    let glb = tassel_gltf::export_glb(&source, &[]).unwrap();
-    let mut rig = c.rig.clone();
+    let glb = common::builtin_glb();
+    let mut rig = tassel::builtin::character().rig;
     rig.springs.clear();
     rig.cloths.clear();
     rig.ropes.clear();

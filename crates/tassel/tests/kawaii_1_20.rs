@@ -42,12 +42,9 @@ use common::hair::component;
 const COLUMNS: usize = 8;
 const LEVELS: usize = 3;
 const DUMMY: f64 = 0.05;
-const TARGET_FPS: f64 = 60.0;
-const DAMPING: f64 = 0.1;
-const STIFFNESS: f64 = 0.05;
-const WORLD_DAMPING_LOCATION: f64 = 0.8;
-const WORLD_DAMPING_ROTATION: f64 = 0.7;
-const GRAVITY: [f64; 3] = [0.0, -9.81, 0.0];
+use common::kawaii::{
+    DAMPING, GRAVITY, STIFFNESS, TARGET_FPS, WORLD_DAMPING_LOCATION, WORLD_DAMPING_ROTATION,
+};
 
 /// Component-space pose of joint `skirt_k_i` (i = 0 is the column's animated root under
 /// the hips at 1 m).

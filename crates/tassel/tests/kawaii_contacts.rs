@@ -38,12 +38,9 @@ use tassel::{CharacterSim, Transform};
 mod common;
 use common::hair::{component, pose, skeleton, BONES};
 
-const TARGET_FPS: f64 = 60.0;
-const DAMPING: f64 = 0.1;
-const STIFFNESS: f64 = 0.05;
-const WORLD_DAMPING_LOCATION: f64 = 0.8;
-const WORLD_DAMPING_ROTATION: f64 = 0.7;
-const GRAVITY: [f64; 3] = [0.0, -9.81, 0.0];
+use common::kawaii::{
+    DAMPING, GRAVITY, STIFFNESS, TARGET_FPS, WORLD_DAMPING_LOCATION, WORLD_DAMPING_ROTATION,
+};
 const POINT_RADIUS: f64 = 0.01;
 const LIMIT_DEG: f64 = 20.0;
 /// A sliding-contact decision within this distance (m) of its threshold is a knife-edge:

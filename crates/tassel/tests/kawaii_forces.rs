@@ -31,13 +31,10 @@ use tassel::{CharacterRig, CharacterSim, Skeleton, Transform};
 
 mod common;
 use common::hair::{component, pose, skeleton, BONES};
-
-const TARGET_FPS: f64 = 60.0;
-const DAMPING: f64 = 0.1;
-const STIFFNESS: f64 = 0.05;
-const WORLD_DAMPING_LOCATION: f64 = 0.8;
-const WORLD_DAMPING_ROTATION: f64 = 0.7;
-const GRAVITY: [f64; 3] = [0.0, -9.81, 0.0];
+use common::kawaii::{
+    fixed_run, rms, DAMPING, GRAVITY, STIFFNESS, TARGET_FPS, WORLD_DAMPING_LOCATION,
+    WORLD_DAMPING_ROTATION,
+};
 
 /// The head's nod at `t`: the chain root's animated rotation (every bone below keeps its
 /// rest local rotation, the identity, so this is every bone's model rotation).
@@ -330,22 +327,7 @@ kawaii!(
 );
 
 fn hair_chain(mode: TimeMode) -> ChainSettings {
-    ChainSettings {
-        name: "hair".into(),
-        root: "hair_0".into(),
-        mode,
-        classic_gravity: ClassicGravity::DtSquared,
-        damping: DAMPING as f32,
-        stiffness: STIFFNESS as f32,
-        world_damping_location: WORLD_DAMPING_LOCATION as f32,
-        world_damping_rotation: WORLD_DAMPING_ROTATION as f32,
-        gravity: Vec3::from(GRAVITY.map(|g| g as f32)),
-        target_framerate: TARGET_FPS as f32,
-        max_delta_time: 1.0,
-        teleport_distance: 0.0,
-        teleport_rotation: 0.0,
-        ..Default::default()
-    }
+    common::kawaii::hair_chain(mode, ClassicGravity::DtSquared)
 }
 
 fn rig_with(mode: TimeMode, forces: Vec<ExternalForceSettings>) -> RigSettings {
@@ -574,32 +556,6 @@ fn a_one_shot_force_acts_on_one_step() {
     }
 }
 
-/// World positions of the hair's joints every 1/6 s over 6 s of sway and turn, fixed mode.
-fn fixed_run(rig: &RigSettings, hz: u32) -> Vec<Vec<Vec3>> {
-    let sk = skeleton();
-    let mut sim = CharacterSim::new(sk.clone(), rig).unwrap();
-    let mut out = Vec::new();
-    for f in 0..=6 * hz {
-        let t = f as f64 / hz as f64;
-        let comp = Transform::from_translation_rotation(
-            Vec3::new((0.3 * (std::f64::consts::TAU * t).sin()) as f32, 0.0, 0.0),
-            Quat::from_rotation_y((0.5 * (std::f64::consts::TAU * 0.7 * t).sin()) as f32),
-        );
-        let dt = if f == 0 { 0.0 } else { 1.0 / hz as f32 };
-        sim.frame(&locals_at(&sk, t), comp, dt).unwrap();
-        if (f * 6) % hz == 0 {
-            out.push(
-                sim.pose()
-                    .models
-                    .iter()
-                    .map(|m| comp.transform_point(m.translation))
-                    .collect(),
-            );
-        }
-    }
-    out
-}
-
 /// Fixed mode with every force on (random scales and an interval included) looks the same
 /// at 30, 60 and 144 Hz: within 1 % of how far the forces move the hair.
 #[test]
@@ -609,22 +565,12 @@ fn fixed_mode_with_external_forces_is_frame_rate_independent() {
     forces[3].random_force_scale_range = [0.0, 2.0];
     let rig = rig_with(TimeMode::Fixed, forces);
     let plain = rig_with(TimeMode::Fixed, Vec::new());
-    let reference = fixed_run(&rig, 144);
-    let without = fixed_run(&plain, 144);
-    let rms = |a: &[Vec<Vec3>], b: &[Vec<Vec3>]| {
-        let (mut d2, mut n) = (0.0f64, 0usize);
-        for (x, y) in a.iter().zip(b) {
-            for (p, q) in x.iter().zip(y) {
-                d2 += (*p - *q).length_squared() as f64;
-                n += 1;
-            }
-        }
-        (d2 / n as f64).sqrt()
-    };
+    let reference = fixed_run(&skeleton(), &rig, 144, locals_at);
+    let without = fixed_run(&skeleton(), &plain, 144, locals_at);
     let effect = rms(&reference, &without);
     assert!(effect > 0.01, "the forces move the hair {effect} m RMS");
     for hz in [30, 60] {
-        let rel = rms(&fixed_run(&rig, hz), &reference) / effect;
+        let rel = rms(&fixed_run(&skeleton(), &rig, hz, locals_at), &reference) / effect;
         println!(
             "{hz} Hz vs 144 Hz: {:.3} % of the forces' RMS effect ({:.1} mm)",
             100.0 * rel,

@@ -13,19 +13,16 @@
 //! port to 2e-5 m.
 
 use glam::{DQuat, DVec3, Quat, Vec3};
-use tassel::dynamics::chain::{ChainSettings, ClassicGravity, TimeMode};
+use tassel::dynamics::chain::{ClassicGravity, TimeMode};
 use tassel::dynamics::RigSettings;
 use tassel::{CharacterSim, Transform};
 
 mod common;
 use common::hair::{component, pose, skeleton, BONES};
 
-const TARGET_FPS: f64 = 60.0;
-const DAMPING: f64 = 0.1;
-const STIFFNESS: f64 = 0.05;
-const WORLD_DAMPING_LOCATION: f64 = 0.8;
-const WORLD_DAMPING_ROTATION: f64 = 0.7;
-const GRAVITY: [f64; 3] = [0.0, -9.81, 0.0];
+use common::kawaii::{
+    DAMPING, GRAVITY, STIFFNESS, TARGET_FPS, WORLD_DAMPING_LOCATION, WORLD_DAMPING_ROTATION,
+};
 
 /// KawaiiPhysics 1.10's `SimulateModifyBones`, component space, in a float type of
 /// choice: `Kawaii` in f64 (UE5's FVector is double: the reference), `Kawaii32` in f32
@@ -126,22 +123,7 @@ fn classic_matches_kawaiiphysics_1_10_without_contacts() {
         (ClassicGravity::PerFrame, true),
     ] {
         let rig = RigSettings {
-            chains: vec![ChainSettings {
-                name: "hair".into(),
-                root: "hair_0".into(),
-                mode: TimeMode::Classic,
-                classic_gravity: gravity,
-                damping: DAMPING as f32,
-                stiffness: STIFFNESS as f32,
-                world_damping_location: WORLD_DAMPING_LOCATION as f32,
-                world_damping_rotation: WORLD_DAMPING_ROTATION as f32,
-                gravity: Vec3::from(GRAVITY.map(|g| g as f32)),
-                target_framerate: TARGET_FPS as f32,
-                max_delta_time: 1.0,
-                teleport_distance: 0.0,
-                teleport_rotation: 0.0,
-                ..Default::default()
-            }],
+            chains: vec![common::kawaii::hair_chain(TimeMode::Classic, gravity)],
             ..Default::default()
         };
         for motion in ["still", "sway", "step", "turn"] {

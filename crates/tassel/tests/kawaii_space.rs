@@ -23,13 +23,11 @@ use tassel::{CharacterRig, CharacterSim, Skeleton, Transform};
 
 mod common;
 use common::hair::{component, pose, BONES};
+use common::kawaii::{
+    fixed_run, rms, DAMPING, GRAVITY, STIFFNESS, TARGET_FPS, WORLD_DAMPING_LOCATION,
+    WORLD_DAMPING_ROTATION,
+};
 
-const TARGET_FPS: f64 = 60.0;
-const DAMPING: f64 = 0.1;
-const STIFFNESS: f64 = 0.05;
-const WORLD_DAMPING_LOCATION: f64 = 0.8;
-const WORLD_DAMPING_ROTATION: f64 = 0.7;
-const GRAVITY: [f64; 3] = [0.0, -9.81, 0.0];
 const HIPS: [f64; 3] = [0.0, 1.0, 0.0];
 const MOVE_SCALE: [f32; 3] = [0.5, 1.0, 0.0];
 
@@ -187,19 +185,6 @@ impl Kawaii {
 
 fn hair_chain(mode: TimeMode, space: SimulationSpace, move_scale: Vec3) -> ChainSettings {
     ChainSettings {
-        name: "hair".into(),
-        root: "hair_0".into(),
-        mode,
-        classic_gravity: ClassicGravity::DtSquared,
-        damping: DAMPING as f32,
-        stiffness: STIFFNESS as f32,
-        world_damping_location: WORLD_DAMPING_LOCATION as f32,
-        world_damping_rotation: WORLD_DAMPING_ROTATION as f32,
-        gravity: Vec3::from(GRAVITY.map(|g| g as f32)),
-        target_framerate: TARGET_FPS as f32,
-        max_delta_time: 1.0,
-        teleport_distance: 0.0,
-        teleport_rotation: 0.0,
         simulation_space: space,
         simulation_base_bone: if space == SimulationSpace::BaseBone {
             "hips".into()
@@ -207,7 +192,7 @@ fn hair_chain(mode: TimeMode, space: SimulationSpace, move_scale: Vec3) -> Chain
             String::new()
         },
         skel_comp_move_scale: move_scale,
-        ..Default::default()
+        ..common::kawaii::hair_chain(mode, ClassicGravity::DtSquared)
     }
 }
 
@@ -316,43 +301,6 @@ fn classic_matches_kawaiiphysics_1_20_simulation_spaces_and_move_scale() {
     println!("worst over every case: {worst_all:.2e} m");
 }
 
-/// World positions of the hair's joints every 1/6 s over 6 s of sway and turn, fixed mode.
-fn fixed_run(rig: &RigSettings, hz: u32) -> Vec<Vec<Vec3>> {
-    let sk = skeleton();
-    let mut sim = CharacterSim::new(sk.clone(), rig).unwrap();
-    let mut out = Vec::new();
-    for f in 0..=6 * hz {
-        let t = f as f64 / hz as f64;
-        let comp = Transform::from_translation_rotation(
-            Vec3::new((0.3 * (std::f64::consts::TAU * t).sin()) as f32, 0.0, 0.0),
-            Quat::from_rotation_y((0.5 * (std::f64::consts::TAU * 0.7 * t).sin()) as f32),
-        );
-        let dt = if f == 0 { 0.0 } else { 1.0 / hz as f32 };
-        sim.frame(&locals_at(&sk, t), comp, dt).unwrap();
-        if (f * 6) % hz == 0 {
-            out.push(
-                sim.pose()
-                    .models
-                    .iter()
-                    .map(|m| comp.transform_point(m.translation))
-                    .collect(),
-            );
-        }
-    }
-    out
-}
-
-fn rms(a: &[Vec<Vec3>], b: &[Vec<Vec3>]) -> f64 {
-    let (mut d2, mut n) = (0.0f64, 0usize);
-    for (x, y) in a.iter().zip(b) {
-        for (p, q) in x.iter().zip(y) {
-            d2 += (*p - *q).length_squared() as f64;
-            n += 1;
-        }
-    }
-    (d2 / n as f64).sqrt()
-}
-
 /// Fixed mode in each space, with the move scale, and with a noisy wind looks the same at
 /// 30, 60 and 144 Hz: within 1 % of the RMS dynamic deviation from the animated pose.
 #[test]
@@ -375,15 +323,15 @@ fn fixed_mode_in_every_space_is_frame_rate_independent() {
     all.push(noisy);
     for (what, chain) in all {
         let rig = rig(chain);
-        let reference = fixed_run(&rig, 144);
+        let reference = fixed_run(&skeleton(), &rig, 144, locals_at);
         // The animated pose: the same run with a stiffness of 1.
         let mut stiff = rig.clone();
         stiff.chains[0].stiffness = 1.0;
         stiff.chains[0].wind.speed = 0.0;
-        let dev = rms(&reference, &fixed_run(&stiff, 144));
+        let dev = rms(&reference, &fixed_run(&skeleton(), &stiff, 144, locals_at));
         assert!(dev > 0.005, "{what}: the hair swings {dev} m RMS");
         for hz in [30, 60] {
-            let rel = rms(&fixed_run(&rig, hz), &reference) / dev;
+            let rel = rms(&fixed_run(&skeleton(), &rig, hz, locals_at), &reference) / dev;
             println!(
                 "{what}: {hz} Hz vs 144 Hz: {:.3} % of the RMS dynamic deviation ({:.1} mm)",
                 100.0 * rel,

@@ -1,4 +1,5 @@
-//! What the tests of the C ABI and the crowd share.
+//! What the tests of the C ABI and the crowd share (each test binary uses part of it).
+#![allow(dead_code)]
 
 use std::path::PathBuf;
 
@@ -27,4 +28,11 @@ pub fn vrm_files() -> Vec<PathBuf> {
         dir.display()
     );
     files
+}
+
+/// The built-in character's skeleton as a GLB (no mesh): the file its rig files run on.
+pub fn builtin_glb() -> Vec<u8> {
+    let c = tassel::builtin::character();
+    let source = tassel_gltf::ExportSource::from_skeleton(&c.skeleton, tassel_gltf::BoneMesh::None);
+    tassel_gltf::export_glb(&source, &[]).unwrap()
 }

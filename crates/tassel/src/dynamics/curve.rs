@@ -20,20 +20,11 @@ impl Curve {
 
     /// The value at `x`.
     pub fn eval(&self, x: f32) -> f32 {
-        let k = &self.keys;
-        match k.len() {
-            0 => 1.0,
-            _ if x <= k[0][0] => k[0][1],
-            n if x >= k[n - 1][0] => k[n - 1][1],
-            _ => {
-                let i = k.partition_point(|key| key[0] <= x).max(1);
-                let (a, b) = (k[i - 1], k[i]);
-                let w = if b[0] > a[0] {
-                    (x - a[0]) / (b[0] - a[0])
-                } else {
-                    0.0
-                };
-                a[1] + (b[1] - a[1]) * w
+        match bracket(&self.keys, x, |k| k[0]) {
+            None => 1.0,
+            Some((i, j, w)) => {
+                let (a, b) = (self.keys[i][1], self.keys[j][1]);
+                a + (b - a) * w
             }
         }
     }
@@ -55,6 +46,30 @@ impl Curve {
         }
         Ok(())
     }
+}
+
+/// Where `x` falls among `keys` (ordered by `key_x`): the two keys to blend and the weight
+/// of the second, the value being `a + (b − a) · w`; held at both ends (one key twice,
+/// weight 0); `None` without keys. Shared by every piecewise-linear curve.
+pub(crate) fn bracket<K>(
+    keys: &[K],
+    x: f32,
+    key_x: impl Fn(&K) -> f32,
+) -> Option<(usize, usize, f32)> {
+    let n = keys.len();
+    if n == 0 {
+        return None;
+    }
+    if x <= key_x(&keys[0]) {
+        return Some((0, 0, 0.0));
+    }
+    if x >= key_x(&keys[n - 1]) {
+        return Some((n - 1, n - 1, 0.0));
+    }
+    let i = keys.partition_point(|k| key_x(k) <= x).max(1);
+    let (a, b) = (key_x(&keys[i - 1]), key_x(&keys[i]));
+    let w = if b > a { (x - a) / (b - a) } else { 0.0 };
+    Some((i - 1, i, w))
 }
 
 #[cfg(test)]

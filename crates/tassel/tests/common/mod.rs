@@ -260,3 +260,83 @@ pub fn dt_with_hitches(f: usize) -> f32 {
         _ => 1.0 / 60.0,
     }
 }
+
+/// What the KawaiiPhysics reference tests share: the chain parameters of their ports, the
+/// hair chain with them, and the fixed-mode frame-rate run.
+pub mod kawaii {
+    use super::*;
+    use tassel::dynamics::chain::{ChainSettings, ClassicGravity, TimeMode};
+    use tassel::dynamics::RigSettings;
+    use tassel::CharacterSim;
+
+    pub const TARGET_FPS: f64 = 60.0;
+    pub const DAMPING: f64 = 0.1;
+    pub const STIFFNESS: f64 = 0.05;
+    pub const WORLD_DAMPING_LOCATION: f64 = 0.8;
+    pub const WORLD_DAMPING_ROTATION: f64 = 0.7;
+    pub const GRAVITY: [f64; 3] = [0.0, -9.81, 0.0];
+
+    /// The hair chain (`hair_0` down) with the ports' parameters, no teleport reset, no
+    /// frame clamp.
+    pub fn hair_chain(mode: TimeMode, classic_gravity: ClassicGravity) -> ChainSettings {
+        ChainSettings {
+            name: "hair".into(),
+            root: "hair_0".into(),
+            mode,
+            classic_gravity,
+            damping: DAMPING as f32,
+            stiffness: STIFFNESS as f32,
+            world_damping_location: WORLD_DAMPING_LOCATION as f32,
+            world_damping_rotation: WORLD_DAMPING_ROTATION as f32,
+            gravity: Vec3::from(GRAVITY.map(|g| g as f32)),
+            target_framerate: TARGET_FPS as f32,
+            max_delta_time: 1.0,
+            teleport_distance: 0.0,
+            teleport_rotation: 0.0,
+            ..Default::default()
+        }
+    }
+
+    /// World positions of every joint every 1/6 s over 6 s at `hz`, the character swaying
+    /// ±0.3 m at 1 Hz and turning ±0.5 rad at 0.7 Hz, the pose from `locals_at(sk, t)`.
+    pub fn fixed_run(
+        sk: &Skeleton,
+        rig: &RigSettings,
+        hz: u32,
+        locals_at: impl Fn(&Skeleton, f64) -> Vec<Transform>,
+    ) -> Vec<Vec<Vec3>> {
+        let mut sim = CharacterSim::new(sk.clone(), rig).unwrap();
+        let mut out = Vec::new();
+        for f in 0..=6 * hz {
+            let t = f as f64 / hz as f64;
+            let comp = Transform::from_translation_rotation(
+                Vec3::new((0.3 * (std::f64::consts::TAU * t).sin()) as f32, 0.0, 0.0),
+                Quat::from_rotation_y((0.5 * (std::f64::consts::TAU * 0.7 * t).sin()) as f32),
+            );
+            let dt = if f == 0 { 0.0 } else { 1.0 / hz as f32 };
+            sim.frame(&locals_at(sk, t), comp, dt).unwrap();
+            if (f * 6) % hz == 0 {
+                out.push(
+                    sim.pose()
+                        .models
+                        .iter()
+                        .map(|m| comp.transform_point(m.translation))
+                        .collect(),
+                );
+            }
+        }
+        out
+    }
+
+    /// The RMS distance between two runs' positions.
+    pub fn rms(a: &[Vec<Vec3>], b: &[Vec<Vec3>]) -> f64 {
+        let (mut d2, mut n) = (0.0f64, 0usize);
+        for (x, y) in a.iter().zip(b) {
+            for (p, q) in x.iter().zip(y) {
+                d2 += (*p - *q).length_squared() as f64;
+                n += 1;
+            }
+        }
+        (d2 / n as f64).sqrt()
+    }
+}

@@ -416,20 +416,10 @@ impl CompiledForce {
 /// ends.
 fn curve_at(keys: &[[f32; 4]], t: f32) -> Vec3 {
     let v = |k: &[f32; 4]| Vec3::new(k[1], k[2], k[3]);
-    let n = keys.len();
-    if n == 0 {
-        return Vec3::ZERO;
+    match crate::dynamics::curve::bracket(keys, t, |k| k[0]) {
+        None => Vec3::ZERO,
+        Some((i, j, w)) => v(&keys[i]) + (v(&keys[j]) - v(&keys[i])) * w,
     }
-    if t <= keys[0][0] {
-        return v(&keys[0]);
-    }
-    if t >= keys[n - 1][0] {
-        return v(&keys[n - 1]);
-    }
-    let i = keys.partition_point(|k| k[0] <= t).max(1);
-    let (a, b) = (&keys[i - 1], &keys[i]);
-    let w = (t - a[0]) / (b[0] - a[0]);
-    v(a) + (v(b) - v(a)) * w
 }
 
 /// Per chain: a force's clock and random generator.
@@ -509,18 +499,24 @@ impl Forces {
             self.bones_fresh = true;
         }
         let mut active = Active::new(force, rig.chains.len());
-        active.one_shot = one_shot;
         if one_shot {
+            // Beside the named force, on, with clocks of its own; never found by name.
+            active.one_shot = true;
             active.enabled = true;
+            self.list.push(active);
+            return;
         }
-        match self
-            .list
-            .iter_mut()
-            .find(|a| a.force.name == active.force.name)
-        {
+        match self.named_mut(&active.force.name) {
             Some(a) => *a = active,
             None => self.list.push(active),
         }
+    }
+
+    /// The named force (one-shots are not found by name).
+    fn named_mut(&mut self, name: &str) -> Option<&mut Active> {
+        self.list
+            .iter_mut()
+            .find(|a| !a.one_shot && a.force.name == name)
     }
 
     /// Adds or replaces (by name) a compiled force.
@@ -530,7 +526,7 @@ impl Forces {
 
     /// Turns the named force on or off; false when there is none of that name.
     pub(crate) fn enable(&mut self, name: &str, on: bool) -> bool {
-        match self.list.iter_mut().find(|a| a.force.name == name) {
+        match self.named_mut(name) {
             Some(a) => {
                 a.enabled = on;
                 true
@@ -539,29 +535,21 @@ impl Forces {
         }
     }
 
-    /// The named force for one step of each chain it reaches, then gone: a copy with its
-    /// own clocks (KawaiiPhysics' one-shot forces of anim notifies). False when there is
-    /// no force of that name.
+    /// The named force for one step of each chain it reaches, then gone: the same compiled
+    /// force with clocks of its own (KawaiiPhysics' one-shot forces of anim notifies).
+    /// False when there is no force of that name.
     pub(crate) fn once(&mut self, rig: &ChainRig, name: &str) -> bool {
-        let Some(force) = self
-            .list
-            .iter()
-            .find(|a| a.force.name == name && !a.one_shot)
-            .map(|a| a.force.clone())
-        else {
+        let Some(force) = self.named_mut(name).map(|a| a.force.clone()) else {
             return false;
         };
-        // A one-shot copy under its own name, so it never replaces the original.
-        let mut copy = (*force).clone();
-        copy.name = format!("{name}\u{0}once{}", self.list.len());
-        self.insert(rig, Arc::new(copy), true);
+        self.insert(rig, force, true);
         true
     }
 
-    /// Removes the named force; false when there is none.
+    /// Removes the named force (not its one-shots under way); false when there is none.
     pub(crate) fn remove(&mut self, name: &str) -> bool {
         let before = self.list.len();
-        self.list.retain(|a| a.force.name != name);
+        self.list.retain(|a| a.one_shot || a.force.name != name);
         self.list.len() != before
     }
 
@@ -581,12 +569,12 @@ impl Forces {
     /// Whether every force was compiled for `rig`'s points and chains.
     pub(crate) fn fits(&self, rig: &ChainRig) -> bool {
         let (n, c) = (rig.point_count(), rig.chains.len());
-        (self.push.is_empty() || (self.push.len() == n && self.accel.len() == n))
+        ((self.push.is_empty() && self.list.is_empty())
+            || (self.push.len() == n && self.accel.len() == n))
             && (self.bone.is_empty() || (self.bone.len() == n && self.prev_bone.len() == n))
             && self.list.iter().all(|a| {
                 a.force.rate.len() == n && a.force.chains.len() == c && a.clocks.len() == c
             })
-            && (self.list.is_empty() || self.push.len() == n)
     }
 
     /// Whether any force is on: then the character's chains step on the scalar path.

@@ -675,15 +675,16 @@ pub(crate) fn wind_cs(s: &super::ChainSettings, component: &Transform) -> Vec3 {
 fn space_step(
     rig: &ChainRig,
     ci: usize,
-    pos: &mut [Vec3],
-    prev: &mut [Vec3],
-    (from, to): (&Transform, &Transform),
+    state: &mut ChainState,
+    from: Transform,
+    to: Transform,
     base_to: Transform,
-    last_base: &mut Transform,
 ) -> SpaceIn {
     let chain = &rig.chains[ci];
     let s = &chain.settings;
-    let (move_cs, rotate_cs) = motion_cs(from, to);
+    let (pos, prev) = (&mut state.pos, &mut state.prev);
+    let last_base = &mut state.last_step_base[ci];
+    let (move_cs, rotate_cs) = motion_cs(&from, &to);
     match s.simulation_space {
         super::SimulationSpace::Component => (move_cs * s.skel_comp_move_scale, rotate_cs, None),
         super::SimulationSpace::World => {
@@ -806,11 +807,10 @@ fn run_chain(
                 let (move_cs, rotate_cs, base) = space_step(
                     rig,
                     ci,
-                    &mut state.pos,
-                    &mut state.prev,
-                    (&state.prev_component, component),
+                    state,
+                    state.prev_component,
+                    *component,
                     state.base_now[ci],
-                    &mut state.last_step_base[ci],
                 );
                 if dt > 0.0 {
                     let forced = state.forces.prepare(
@@ -1027,11 +1027,10 @@ fn run_fixed(rig: &ChainRig, ci: usize, state: &mut ChainState, dt: f32, level: 
         let (move_cs, rotate_cs, base) = space_step(
             rig,
             ci,
-            &mut state.pos,
-            &mut state.prev,
-            (&state.last_step_component[ci], &comp_b),
+            state,
+            state.last_step_component[ci],
+            comp_b,
             base_b,
-            &mut state.last_step_base[ci],
         );
         let forced = state
             .forces
@@ -1113,11 +1112,10 @@ fn run_group(
                     state.space_in[ci] = space_step(
                         rig,
                         ci,
-                        &mut state.pos,
-                        &mut state.prev,
-                        (&state.prev_component, component),
+                        state,
+                        state.prev_component,
+                        *component,
                         state.base_now[ci],
-                        &mut state.last_step_base[ci],
                     );
                 }
                 if dt > 0.0 {
@@ -1299,15 +1297,7 @@ fn run_fixed_group(
         }
         for &ci in &group.chains {
             let base_b = state.base_prev[ci].lerp(&state.base_now[ci], w);
-            state.space_in[ci] = space_step(
-                rig,
-                ci,
-                &mut state.pos,
-                &mut state.prev,
-                (&from, &comp_b),
-                base_b,
-                &mut state.last_step_base[ci],
-            );
+            state.space_in[ci] = space_step(rig, ci, state, from, comp_b, base_b);
             state
                 .forces
                 .prepare(rig, ci, h, w, &comp_b, &state.pos, &state.step_targets);
