@@ -1,14 +1,16 @@
 //! A crowd of swaying avatars in a headless Bevy app: what the plugin costs per frame.
 //!
 //! ```text
-//! cargo run --release -p tassel-bevy --example crowd -- [N] [--mode fixed|spec] [--frames F] [--own]
+//! cargo run --release -p tassel-bevy --example crowd -- [N] [--mode fixed|spec] [--frames F] [--own] [--threads T]
 //! cargo run --release -p tassel-bevy --features gltf --example crowd -- N path/to/avatar.vrm
 //! ```
 //! N characters (default 1 000) of one kind, each on its own phase of a sway, 60 frames a
 //! second of game time. Without a file each is the built-in bench avatar: two strands of
 //! eight VRM spring joints and four sphere colliders (16 joints). `--own` keeps every
 //! character on its own `CharacterSim` (the plugin's path for kinds a crowd cannot take)
-//! instead of its kind's crowd. Prints the plugin's step (`tassel_bevy::STEP_TIME`: read,
+//! instead of its kind's crowd. `--threads T` gives Bevy's compute task pool T threads
+//! (Bevy's default on two cores is one: its I/O and async pools take a thread each).
+//! Prints the plugin's step (`tassel_bevy::STEP_TIME`: read,
 //! step and write-back of every character) in ms per frame and ns per joint-step, and the
 //! whole frame (`App::update`) against the same app whose characters have no
 //! `SecondaryMotion`; medians.
@@ -20,7 +22,7 @@ use bevy::time::TimeUpdateStrategy;
 use std::time::{Duration, Instant};
 use tassel::dynamics::SimMode;
 use tassel_bevy::prelude::*;
-use tassel_bevy::STEP_TIME;
+use tassel_bevy::{READ_TIME, SOLVE_TIME, STEP_TIME, WRITE_TIME};
 
 struct Options {
     n: usize,
@@ -28,6 +30,7 @@ struct Options {
     mode: SimMode,
     frames: usize,
     own: bool,
+    threads: Option<usize>,
 }
 
 fn options() -> Result<Options, String> {
@@ -37,6 +40,7 @@ fn options() -> Result<Options, String> {
         mode: SimMode::Fixed,
         frames: 200,
         own: false,
+        threads: None,
     };
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
@@ -55,6 +59,13 @@ fn options() -> Result<Options, String> {
                     .map_err(|e| format!("--frames: {e}"))?
             }
             "--own" => o.own = true,
+            "--threads" => {
+                o.threads = Some(
+                    value("--threads")?
+                        .parse()
+                        .map_err(|e| format!("--threads: {e}"))?,
+                )
+            }
             _ if a.parse::<usize>().is_ok() => o.n = a.parse().unwrap(),
             _ if !a.starts_with('-') => o.file = Some(a.into()),
             _ => return Err(format!("unknown option {a}")),
@@ -78,11 +89,21 @@ fn sway(time: Res<Time>, mut q: Query<(&mut Transform, &Sway)>) {
     }
 }
 
-/// A headless app: time advances 1/60 s per update.
-fn app(folder: &str) -> App {
+/// A headless app: time advances 1/60 s per update; `threads` for the compute pool.
+fn app(folder: &str, threads: Option<usize>) -> App {
+    let mut tasks = TaskPoolPlugin::default();
+    if let Some(n) = threads {
+        tasks.task_pool_options.compute = bevy::app::TaskPoolThreadAssignmentPolicy {
+            min_threads: n,
+            max_threads: n,
+            percent: 1.0,
+            on_thread_spawn: None,
+            on_thread_destroy: None,
+        };
+    }
     let mut app = App::new();
     app.add_plugins((
-        MinimalPlugins,
+        MinimalPlugins.set(tasks),
         AssetPlugin {
             file_path: folder.to_string(),
             ..default()
@@ -206,21 +227,26 @@ fn median(mut v: Vec<f64>) -> f64 {
     v[v.len() / 2]
 }
 
-/// Runs `frames` updates; returns each update's wall time and the step diagnostic's
-/// value (ms).
-fn run(app: &mut App, frames: usize) -> (Vec<f64>, Vec<f64>) {
-    let (mut whole, mut step) = (Vec::new(), Vec::new());
+/// Runs `frames` updates; returns each update's wall time and the step diagnostics'
+/// values (ms): the whole step, its read, solve and write parts.
+fn run(app: &mut App, frames: usize) -> (Vec<f64>, [Vec<f64>; 4]) {
+    let (mut whole, mut step) = (Vec::new(), <[Vec<f64>; 4]>::default());
     for _ in 0..frames {
         let t = Instant::now();
         app.update();
         whole.push(t.elapsed().as_secs_f64() * 1e3);
-        if let Some(v) = app
-            .world()
-            .get_resource::<DiagnosticsStore>()
-            .and_then(|d| d.get(&STEP_TIME))
-            .and_then(|d| d.value())
+        for (path, values) in [STEP_TIME, READ_TIME, SOLVE_TIME, WRITE_TIME]
+            .iter()
+            .zip(&mut step)
         {
-            step.push(v);
+            if let Some(v) = app
+                .world()
+                .get_resource::<DiagnosticsStore>()
+                .and_then(|d| d.get(path))
+                .and_then(|d| d.value())
+            {
+                values.push(v);
+            }
         }
     }
     (whole, step)
@@ -247,7 +273,7 @@ fn main() {
     };
     let mut measured = Vec::new();
     for plugin in [true, false] {
-        let mut app = app(&folder);
+        let mut app = app(&folder, o.threads);
         let joints = match &name {
             Some(name) => spawn_file(&mut app, &o, name, plugin),
             None => Ok(spawn_builtin(&mut app, &o, plugin)),
@@ -278,15 +304,14 @@ fn main() {
         let (whole, step) = run(&mut app, o.frames);
         measured.push((
             median(whole),
-            (!step.is_empty()).then(|| median(step)),
+            step.map(|v| if v.is_empty() { f64::NAN } else { median(v) }),
             joints,
         ));
     }
-    let (with, step, joints) = measured[0];
+    let (with, [step, read, solve, write], joints) = measured[0];
     let (without, _, _) = measured[1];
-    let step = step.unwrap_or(f64::NAN);
     println!(
-        "{} characters x {joints} spring joints, {:?} mode, {}, {} frames (medians):",
+        "{} characters x {joints} spring joints, {:?} mode, {}, {} frames, {} compute threads (medians):",
         o.n,
         o.mode,
         if o.own {
@@ -294,11 +319,15 @@ fn main() {
         } else {
             "crowd"
         },
-        o.frames
+        o.frames,
+        bevy::tasks::ComputeTaskPool::get().thread_num()
     );
     println!(
         "  plugin step {step:.3} ms per frame, {:.1} ns per joint-step",
         step * 1e6 / (o.n * joints.max(1)) as f64
+    );
+    println!(
+        "  of which: read {read:.3} ms, solve {solve:.3} ms, write {write:.3} ms (medians of each)"
     );
     println!(
         "  whole frame {with:.3} ms with the plugin, {without:.3} ms without ({:.2}x)",

@@ -22,6 +22,9 @@ type RigKey = (
     Option<AssetId<TasselRig>>,
     &'static str,
     bool,
+    // The VRM step rate's bits and the most steps per frame, when set.
+    Option<u32>,
+    Option<u32>,
 );
 
 /// Compiled rigs by kind, held weakly: the last character of a kind to go frees it.
@@ -160,10 +163,12 @@ pub(crate) fn bind_characters(
             motion.rig.as_ref().map(|r| r.id()),
             motion.mode.name(),
             motion.vrm_springs,
+            motion.vrm_step_rate.map(f32::to_bits),
+            motion.max_steps_per_frame,
         );
         let compiled = match cache.rigs.get(&key).and_then(Weak::upgrade) {
             Some(c) => c,
-            None => match compile(model, rig.map(|r| &r.0), motion.mode, motion.vrm_springs) {
+            None => match compile(model, rig.map(|r| &r.0), &motion) {
                 Ok(c) => {
                     let c = Arc::new(c);
                     cache.rigs.retain(|_, w| w.strong_count() > 0);
@@ -225,13 +230,13 @@ pub(crate) fn bind_characters(
     }
 }
 
-/// Compiles a model with an optional rig in a mode.
+/// Compiles a model with an optional rig as `motion` asks (mode, VRM springs, stepping).
 fn compile(
     model: &TasselModel,
     rig: Option<&RigSettings>,
-    mode: SimMode,
-    vrm_springs: bool,
+    motion: &SecondaryMotion,
 ) -> Result<CharacterRig, String> {
+    let (mode, vrm_springs) = (motion.mode, motion.vrm_springs);
     let mut settings = rig.cloned().unwrap_or_default();
     let empty = VrmSpringBones::default();
     let vrm = match model.vrm() {
@@ -245,8 +250,14 @@ fn compile(
         SimMode::Spec | SimMode::ThreeVrm if !has_vrm => None,
         m => Some(m),
     };
-    let (_, options) =
+    let (_, mut options) =
         SimMode::apply(requested, &mut settings, has_vrm).map_err(|e| e.to_string())?;
+    if let Some(rate) = motion.vrm_step_rate {
+        options.step_rate = rate;
+    }
+    if let Some(n) = motion.max_steps_per_frame {
+        options.max_steps_per_frame = n;
+    }
     CharacterRig::with_vrm((**model.skeleton()).clone(), &settings, vrm, options)
         .map_err(|e| format!("the character does not compile: {e}"))
 }

@@ -38,6 +38,13 @@ pub struct SecondaryMotion {
     /// Step with the other characters of its kind in a crowd where the kind allows
     /// (default `true`); `false` keeps its own [`CharacterSim`].
     pub crowd: bool,
+    /// `fixed` mode: the VRM springs' steps per second (10..=1000; `None`: 60, the rate
+    /// their parameters are tuned at). A rig file's chains, cloths and ropes keep the
+    /// rates it gives them.
+    pub vrm_step_rate: Option<f32>,
+    /// `fixed` mode: the VRM springs' most steps in one frame (`None`: the default, 8);
+    /// after a longer hitch the time beyond is dropped.
+    pub max_steps_per_frame: Option<u32>,
 }
 
 impl SecondaryMotion {
@@ -49,7 +56,22 @@ impl SecondaryMotion {
             mode: SimMode::Fixed,
             vrm_springs: true,
             crowd: true,
+            vrm_step_rate: None,
+            max_steps_per_frame: None,
         }
+    }
+
+    /// `fixed` mode: the VRM springs step `rate` times a second (10..=1000; a value
+    /// outside gives `TasselFailed` naming it).
+    pub fn with_vrm_step_rate(mut self, rate: f32) -> Self {
+        self.vrm_step_rate = Some(rate);
+        self
+    }
+
+    /// `fixed` mode: the VRM springs take at most `n` steps in one frame.
+    pub fn with_max_steps_per_frame(mut self, n: u32) -> Self {
+        self.max_steps_per_frame = Some(n);
+        self
     }
 
     /// Adds a rig file's chains, springs, cloths and ropes.

@@ -2,8 +2,11 @@
 //! rig ([`CrowdKind::of`]), with the characters' animated input and the simulated output in
 //! flat buffers, one slot per character.
 
+use crate::step::{to_tassel, world_of};
 use bevy::ecs::prelude::*;
 use bevy::platform::collections::HashMap;
+use bevy::prelude::{ChildOf, Transform as BevyTransform};
+use bevy::tasks::ComputeTaskPool;
 use std::sync::Arc;
 use tassel::crowd::{ChainCrowd, CrowdKind, CrowdPose, VrmCrowd};
 use tassel::{CharacterRig, Error, Transform};
@@ -34,6 +37,24 @@ pub(crate) struct Kind {
     /// Scratch for `write_pose` (whole-pose kinds).
     pub(crate) scratch_locals: Vec<Transform>,
     pub(crate) scratch_models: Vec<Transform>,
+    /// The joints written back (the kind's simulated joints, ascending; each has a bone
+    /// entity, or the character would not have started).
+    pub(crate) written: Vec<usize>,
+    /// For each slot of `read`: its index in `written`, when the plugin writes that joint.
+    pub(crate) read_written: Vec<Option<usize>>,
+    /// Member after member: the bone entity of each `read` joint (`None`: not found,
+    /// the joint stays at rest).
+    pub(crate) read_bones: Vec<Option<Entity>>,
+    /// Member after member: the bone entity of each `written` joint.
+    pub(crate) write_bones: Vec<Entity>,
+    /// Member after member: what the plugin wrote into each `written` bone last frame. A
+    /// bone still holding it was not animated since, and keeps its last animated pose as
+    /// input (no feedback of the simulated pose into the next frame's input).
+    pub(crate) wrote: Vec<Option<Transform>>,
+    /// Each member's model-space entity (the parent of its root bone's entity).
+    pub(crate) spaces: Vec<Option<Entity>>,
+    /// Members held this frame (bad input): their bones are not written.
+    pub(crate) held: Vec<bool>,
 }
 
 impl Kind {
@@ -55,6 +76,8 @@ impl Kind {
                     (Run::Chains(crowd), (0..n).collect(), false)
                 }
             };
+            let written = rig.simulated_joints().to_vec();
+            let read_written = read.iter().map(|j| written.binary_search(j).ok()).collect();
             Ok(Kind {
                 rig: rig.clone(),
                 run,
@@ -65,6 +88,13 @@ impl Kind {
                 whole_pose,
                 scratch_locals: sk.rest().to_vec(),
                 scratch_models: sk.rest().to_vec(),
+                written,
+                read_written,
+                read_bones: Vec::new(),
+                write_bones: Vec::new(),
+                wrote: Vec::new(),
+                spaces: Vec::new(),
+                held: Vec::new(),
             })
         };
         Some(make())
@@ -74,8 +104,18 @@ impl Kind {
         self.rig.skeleton().len()
     }
 
-    /// Adds `entity`; returns its index. It starts from its pose on its next frame.
-    pub(crate) fn add(&mut self, entity: Entity) -> usize {
+    /// Adds `entity`, whose joints' entities are `bones` and model space `space`;
+    /// returns its index. It starts from its pose on its next frame.
+    pub(crate) fn add(
+        &mut self,
+        entity: Entity,
+        bones: &[Option<Entity>],
+        space: Option<Entity>,
+    ) -> Option<usize> {
+        // Bind checked that every simulated joint has an entity; a kind's joints are the
+        // same for every member.
+        let write: Option<Vec<Entity>> = self.written.iter().map(|&j| bones[j]).collect();
+        let write = write?;
         let i = match &mut self.run {
             Run::Vrm(c) => c.add(),
             Run::Chains(c) => c.add(),
@@ -84,7 +124,12 @@ impl Kind {
         self.members.push(entity);
         self.locals.extend_from_slice(self.rig.skeleton().rest());
         self.roots.push(Transform::IDENTITY);
-        i
+        self.read_bones.extend(self.read.iter().map(|&j| bones[j]));
+        self.write_bones.extend(write);
+        self.wrote.extend(self.written.iter().map(|_| None));
+        self.spaces.push(space);
+        self.held.push(false);
+        Some(i)
     }
 
     /// Removes member `i`; the last member takes its index: returns that member's entity
@@ -99,17 +144,13 @@ impl Kind {
         };
         self.members.swap_remove(i);
         self.roots.swap_remove(i);
-        if i != last {
-            self.locals.copy_within(last * n..(last + 1) * n, i * n);
-        }
-        self.locals.truncate(last * n);
+        self.spaces.swap_remove(i);
+        self.held.swap_remove(i);
+        swap_remove_run(&mut self.locals, n, i);
+        swap_remove_run(&mut self.read_bones, self.read.len(), i);
+        swap_remove_run(&mut self.write_bones, self.written.len(), i);
+        swap_remove_run(&mut self.wrote, self.written.len(), i);
         (i != last).then(|| self.members[i])
-    }
-
-    /// Member `i`'s animated local pose (every joint).
-    pub(crate) fn locals_mut(&mut self, i: usize) -> &mut [Transform] {
-        let n = self.joints();
-        &mut self.locals[i * n..(i + 1) * n]
     }
 
     /// Member `i` starts again from its pose on the next frame.
@@ -120,32 +161,99 @@ impl Kind {
         };
     }
 
-    /// Every member advances by `dt`; members whose input is bad are held (their state as
-    /// before) and listed in `held`.
+    /// Every member advances by `dt`, the lane groups shared out over Bevy's compute
+    /// task pool (rayon's own threads beside Bevy's made the step slower: the two pools
+    /// fought for the cores); members whose input is bad are held (their state as before),
+    /// marked in `self.held` and listed in `held`.
     pub(crate) fn frame(&mut self, dt: f32, held: &mut Vec<(usize, Error)>) {
         held.clear();
+        self.held.fill(false);
         let n = self.joints();
         let (locals, roots) = (&self.locals, &self.roots);
         let input = |i: usize| CrowdPose {
             transform: roots[i],
             locals: &locals[i * n..(i + 1) * n],
         };
+        let pool = ComputeTaskPool::get();
+        let parts = parts(pool);
         let result = match &mut self.run {
-            Run::Vrm(c) => c.frame(dt, input),
-            Run::Chains(c) => c.frame(dt, input),
+            Run::Vrm(c) => c.frame_parts(dt, input, parts, |jobs| {
+                pool.scope(|s| jobs.for_each(|job| s.spawn(async move { job.run() })));
+            }),
+            Run::Chains(c) => c.frame_parts(dt, input, parts, |jobs| {
+                pool.scope(|s| jobs.for_each(|job| s.spawn(async move { job.run() })));
+            }),
         };
         if result.is_err() {
             match &self.run {
                 Run::Vrm(c) => held.extend(c.held().map(|(i, e)| (i, e.clone()))),
                 Run::Chains(c) => held.extend(c.held().map(|(i, e)| (i, e.clone()))),
             }
+            for &(i, _) in held.iter() {
+                self.held[i] = true;
+            }
         }
     }
 
-    /// Member `i`'s simulated local pose: its animated locals with the solvers' rotations.
-    /// Only the joints of `written` (simulated joints, ascending) are fresh; the others
-    /// hold whatever an earlier member left (the write-back reads no other).
-    pub(crate) fn output(&mut self, i: usize, written: &[(usize, Entity)]) -> &[Transform] {
+    /// Reads every member's world transform and animated bones into `roots` and `locals`,
+    /// the members shared out over Bevy's compute task pool.
+    pub(crate) fn read(&mut self, transforms: &Query<&BevyTransform>, parents: &Query<&ChildOf>) {
+        let members = self.members.len();
+        if members == 0 {
+            return;
+        }
+        let (n, r, w) = (self.joints(), self.read.len(), self.written.len());
+        let pool = ComputeTaskPool::get();
+        let chunk = members.div_ceil(parts(pool));
+        let (read, read_written) = (&self.read, &self.read_written);
+        let (bones, wrote, spaces) = (&self.read_bones, &self.wrote, &self.spaces);
+        let (locals, roots) = (&mut self.locals, &mut self.roots);
+        pool.scope(|s| {
+            for (c, (locals, roots)) in locals
+                .chunks_mut(chunk * n)
+                .zip(roots.chunks_mut(chunk))
+                .enumerate()
+            {
+                let (a, b) = (c * chunk, c * chunk + roots.len());
+                let part = Members {
+                    read,
+                    read_written,
+                    bones: &bones[a * r..b * r],
+                    wrote: &wrote[a * w..b * w],
+                    spaces: &spaces[a..b],
+                };
+                s.spawn(async move { part.read(locals, roots, transforms, parents) });
+            }
+        });
+    }
+
+    /// Writes every member's simulated bones (but a held member's: its bones keep their
+    /// animated pose).
+    pub(crate) fn write(&mut self, transforms: &mut Query<&mut BevyTransform>) {
+        let w = self.written.len();
+        for i in 0..self.members.len() {
+            if self.held[i] {
+                continue;
+            }
+            self.output(i);
+            let bones = &self.write_bones[i * w..(i + 1) * w];
+            let wrote = &mut self.wrote[i * w..(i + 1) * w];
+            for ((&j, &e), wrote) in self.written.iter().zip(bones).zip(wrote) {
+                if let Ok(mut t) = transforms.get_mut(e) {
+                    let l = self.scratch_locals[j];
+                    t.translation = l.translation;
+                    t.rotation = l.rotation;
+                    t.scale = l.scale;
+                    *wrote = Some(l);
+                }
+            }
+        }
+    }
+
+    /// Member `i`'s simulated local pose into `scratch_locals`: its animated locals with
+    /// the solvers' rotations. Only the `written` joints are fresh; the others hold
+    /// whatever an earlier member left (the write-back reads no other).
+    fn output(&mut self, i: usize) {
         let n = self.joints();
         let input = &self.locals[i * n..(i + 1) * n];
         if self.whole_pose {
@@ -153,7 +261,7 @@ impl Kind {
         } else {
             // The crowd turns simulated joints only: their animated translation and scale
             // are the output's, and their rotation is written below.
-            for &(j, _) in written {
+            for &j in &self.written {
                 self.scratch_locals[j] = input[j];
             }
         }
@@ -163,8 +271,71 @@ impl Kind {
             Run::Vrm(c) => c.write_rotations(i, out),
             Run::Chains(c) => c.write_rotations(i, out),
         };
-        &self.scratch_locals
     }
+}
+
+/// A run of members as the read pass sees them (a share of a kind's flat lists).
+struct Members<'k> {
+    read: &'k [usize],
+    read_written: &'k [Option<usize>],
+    bones: &'k [Option<Entity>],
+    wrote: &'k [Option<Transform>],
+    spaces: &'k [Option<Entity>],
+}
+
+impl Members<'_> {
+    /// Each member's world transform into `roots` and its animated pose into `locals`
+    /// (`read` joints only). A written bone that still holds what the plugin wrote last
+    /// frame was not animated since (no clip drives it): it keeps its last animated pose.
+    /// A bone without an entity stays at rest.
+    fn read(
+        &self,
+        locals: &mut [Transform],
+        roots: &mut [Transform],
+        transforms: &Query<&BevyTransform>,
+        parents: &Query<&ChildOf>,
+    ) {
+        let (n, r, w) = (
+            locals.len() / roots.len(),
+            self.read.len(),
+            self.wrote.len() / roots.len(),
+        );
+        for (m, root) in roots.iter_mut().enumerate() {
+            *root = world_of(self.spaces[m], transforms, parents);
+            let locals = &mut locals[m * n..(m + 1) * n];
+            let bones = &self.bones[m * r..(m + 1) * r];
+            let wrote = &self.wrote[m * w..(m + 1) * w];
+            for ((&j, bone), written) in self.read.iter().zip(bones).zip(self.read_written) {
+                let Some(t) = bone.and_then(|e| transforms.get(e).ok()) else {
+                    continue;
+                };
+                let t = to_tassel(t);
+                if written.is_some_and(|k| wrote[k] == Some(t)) {
+                    continue;
+                }
+                locals[j] = t;
+            }
+        }
+    }
+}
+
+/// How many shares to cut a pass into: one per thread of the pool, and one for the
+/// thread that waits in its `scope` (it runs tasks too). On two cores Bevy gives the
+/// compute pool one thread; the system's own thread is the second.
+fn parts(pool: &ComputeTaskPool) -> usize {
+    pool.thread_num() + 1
+}
+
+/// Removes run `i` (of `len` items) from `v`, the last run taking its place.
+fn swap_remove_run<T: Copy>(v: &mut Vec<T>, len: usize, i: usize) {
+    if len == 0 {
+        return;
+    }
+    let last = v.len() / len - 1;
+    if i != last {
+        v.copy_within(last * len..(last + 1) * len, i * len);
+    }
+    v.truncate(last * len);
 }
 
 /// Every crowd, by its compiled rig (the `Arc`'s address: the kind keeps it alive).
@@ -185,7 +356,13 @@ pub(crate) fn key(rig: &Arc<CharacterRig>) -> usize {
 impl Crowds {
     /// Adds `entity` (a character of kind `rig`) to its kind's crowd when the kind runs as
     /// one; returns its index, or `None` (the character steps on its own).
-    pub(crate) fn join(&mut self, entity: Entity, rig: &Arc<CharacterRig>) -> Option<usize> {
+    pub(crate) fn join(
+        &mut self,
+        entity: Entity,
+        rig: &Arc<CharacterRig>,
+        bones: &[Option<Entity>],
+        space: Option<Entity>,
+    ) -> Option<usize> {
         let k = key(rig);
         if self
             .not_crowds
@@ -207,9 +384,20 @@ impl Crowds {
             }
         }
         let kind = self.kinds.get_mut(&k)?;
-        let i = kind.add(entity);
+        let Some(i) = kind.add(entity, bones, space) else {
+            if kind.members.is_empty() {
+                self.kinds.remove(&k);
+            }
+            return None;
+        };
         self.members.insert(entity, (k, i));
         Some(i)
+    }
+
+    /// The kind and index of crowd member `entity`.
+    pub(crate) fn kind_of(&mut self, entity: Entity) -> Option<(&mut Kind, usize)> {
+        let &(k, i) = self.members.get(&entity)?;
+        Some((self.kinds.get_mut(&k)?, i))
     }
 
     /// Removes `entity` from its crowd, if it is in one: returns the member that took its

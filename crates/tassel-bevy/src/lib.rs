@@ -59,7 +59,7 @@ pub use character::{SecondaryMotion, TasselCharacter, TasselFailed};
 pub use controller::{CharacterController, TasselCollider, TasselLevel};
 #[cfg(feature = "gizmos")]
 pub use gizmos::TasselGizmosPlugin;
-pub use step::STEP_TIME;
+pub use step::{READ_TIME, SOLVE_TIME, STEP_TIME, WRITE_TIME};
 pub use tassel;
 pub use tassel::dynamics::SimMode;
 #[cfg(feature = "gltf")]
@@ -114,6 +114,9 @@ pub struct TasselPlugin;
 
 impl Plugin for TasselPlugin {
     fn build(&self, app: &mut App) {
+        for d in step::step_time_diagnostics() {
+            app.register_diagnostic(d);
+        }
         app.init_asset::<TasselModel>()
             .init_asset::<TasselRig>()
             .register_asset_loader(TasselModelLoader)
@@ -121,7 +124,6 @@ impl Plugin for TasselPlugin {
             .add_message::<TasselError>()
             .init_resource::<bind::RigCache>()
             .init_resource::<crowd::Crowds>()
-            .register_diagnostic(step::step_time_diagnostic())
             .init_resource::<TasselLevel>()
             .configure_sets(
                 PostUpdate,

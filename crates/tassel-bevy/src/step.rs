@@ -23,9 +23,21 @@ use std::time::Instant;
 /// `DiagnosticsStore`.
 pub const STEP_TIME: DiagnosticPath = DiagnosticPath::const_new("tassel/step_ms");
 
-/// The same diagnostic registered with its unit.
-pub(crate) fn step_time_diagnostic() -> Diagnostic {
-    Diagnostic::new(STEP_TIME).with_suffix(" ms")
+/// The part of [`STEP_TIME`] spent reading the animated bones (and character roots)
+/// into the solvers' input buffers, milliseconds.
+pub const READ_TIME: DiagnosticPath = DiagnosticPath::const_new("tassel/read_ms");
+
+/// The part of [`STEP_TIME`] spent in the solvers (every crowd and every character on
+/// its own simulation), milliseconds.
+pub const SOLVE_TIME: DiagnosticPath = DiagnosticPath::const_new("tassel/solve_ms");
+
+/// The part of [`STEP_TIME`] spent writing the simulated bones' `Transform`s,
+/// milliseconds.
+pub const WRITE_TIME: DiagnosticPath = DiagnosticPath::const_new("tassel/write_ms");
+
+/// The step's diagnostics, registered with their unit.
+pub(crate) fn step_time_diagnostics() -> [Diagnostic; 4] {
+    [STEP_TIME, READ_TIME, SOLVE_TIME, WRITE_TIME].map(|p| Diagnostic::new(p).with_suffix(" ms"))
 }
 
 /// Bevy's `Transform` as Tassel's (the same glam types).
@@ -37,7 +49,7 @@ pub(crate) fn to_tassel(t: &Transform) -> tassel::Transform {
 /// `GlobalTransform`: propagation has not run yet), composed as Tassel composes.
 pub(crate) fn world_of(
     entity: Option<Entity>,
-    transforms: &Query<&mut Transform>,
+    transforms: &Query<&Transform>,
     parents: &Query<&ChildOf>,
 ) -> tassel::Transform {
     // Composed only where there is a parent: a lone entity's transform is used as it is
@@ -57,15 +69,15 @@ pub(crate) fn world_of(
     world.unwrap_or(tassel::Transform::IDENTITY)
 }
 
-/// Reads character `c`'s animated pose into `locals` (only `joints`, or every joint when
-/// `None`): every bone's Transform as the animation left it. A simulated bone that still
-/// holds what the plugin wrote last frame was not animated since (no clip drives it): it
-/// keeps its last animated pose. A bone without an entity stays at rest.
+/// Reads character `c`'s animated pose into `locals`: every bone's Transform as the
+/// animation left it. A simulated bone that still holds what the plugin wrote last frame
+/// was not animated since (no clip drives it): it keeps its last animated pose. A bone
+/// without an entity stays at rest. (Crowd members are read by their kind:
+/// `Kind::read`.)
 fn read_pose(
     c: &TasselCharacter,
-    joints: Option<&[usize]>,
     locals: &mut [tassel::Transform],
-    transforms: &Query<&mut Transform>,
+    transforms: &Query<&Transform>,
 ) {
     let mut read = |j: usize, mine: Option<tassel::Transform>| {
         if let Some(t) = c.bones[j].and_then(|e| transforms.get(e).ok()) {
@@ -75,7 +87,7 @@ fn read_pose(
             }
         }
     };
-    // `written` is ascending by joint, as `joints` and `0..n` are: one merge walk.
+    // `written` is ascending by joint, as `0..n` is: one merge walk.
     let mut w = 0;
     let mut mine = |j: usize| {
         while c.written.get(w).is_some_and(|&(k, _)| k < j) {
@@ -86,10 +98,7 @@ fn read_pose(
             _ => None,
         }
     };
-    match joints {
-        Some(joints) => joints.iter().for_each(|&j| read(j, mine(j))),
-        None => (0..c.bones.len()).for_each(|j| read(j, mine(j))),
-    }
+    (0..c.bones.len()).for_each(|j| read(j, mine(j)));
 }
 
 /// Writes the simulated joints of `pose` to character `c`'s bones.
@@ -151,45 +160,43 @@ pub(crate) fn step_characters(
         }
     }
     // New crowd members join (a character whose kind runs as a crowd has no sim of its
-    // own: bind left it `None`).
+    // own: bind left it `None`); a member whose solvers start again (first frame, reset,
+    // teleport) tells its crowd.
     for (entity, mut c) in &mut characters {
         if c.sim.is_none() && c.slot.is_none() {
             let rig = c.rig.clone();
-            match crowds.join(entity, &rig) {
+            match crowds.join(entity, &rig, &c.bones, c.space) {
                 Some(i) => c.slot = Some(i),
                 // Not a crowd after all (its crowd failed to build): its own sim.
                 None => c.sim = Some(tassel::CharacterSim::from_rig(rig)),
             }
         }
-    }
-    // Read.
-    for (entity, mut c) in &mut characters {
-        let c = &mut *c;
-        let root = world_of(c.space, &transforms, &parents);
-        match c.slot {
-            Some(i) => {
-                let Some(&(k, _)) = crowds.members.get(&entity) else {
-                    continue;
-                };
-                let kind = crowds.kinds.get_mut(&k).expect("a member's kind exists");
-                let read = std::mem::take(&mut kind.read);
-                read_pose(c, Some(&read), kind.locals_mut(i), &transforms);
-                kind.read = read;
-                kind.roots[i] = root;
-                if c.first_frame {
-                    kind.reset(i);
-                    c.first_frame = false;
-                }
+        if c.first_frame && c.slot.is_some() {
+            if let Some((kind, i)) = crowds.kind_of(entity) {
+                kind.reset(i);
             }
-            None => {
-                let mut locals = std::mem::take(&mut c.locals);
-                read_pose(c, None, &mut locals, &transforms);
-                c.locals = locals;
-                c.root = root;
-            }
+            c.first_frame = false;
         }
     }
-    // Step: the characters on their own sims in parallel, then each crowd (rayon).
+    // Read: the characters on their own sims, then every crowd's members (in parallel).
+    {
+        let transforms = transforms.as_readonly();
+        for (_, mut c) in &mut characters {
+            let c = &mut *c;
+            if c.sim.is_some() {
+                c.root = world_of(c.space, &transforms, &parents);
+                let mut locals = std::mem::take(&mut c.locals);
+                read_pose(c, &mut locals, &transforms);
+                c.locals = locals;
+            }
+        }
+        for kind in crowds.kinds.values_mut() {
+            kind.read(&transforms, &parents);
+        }
+    }
+    let read = Instant::now();
+    // Step: the characters on their own sims in parallel, then each crowd (its lane
+    // groups in parallel), all on Bevy's compute task pool.
     characters.par_iter_mut().for_each(|(_, mut c)| {
         let c = &mut *c;
         let Some(sim) = c.sim.as_mut() else {
@@ -218,30 +225,30 @@ pub(crate) fn step_characters(
             }
         }
     }
-    // Write.
+    let solved = Instant::now();
+    // Write: every crowd's members, then the characters on their own sims; errors.
+    for kind in crowds.kinds.values_mut() {
+        kind.write(&mut transforms);
+    }
     for (entity, mut c) in &mut characters {
+        if c.result.is_none() && c.last_error.is_none() && c.sim.is_none() {
+            continue;
+        }
         let c = &mut *c;
         if let Some(message) = c.result.take() {
             report(entity, c, message, &mut errors);
             continue;
         }
         c.last_error = None;
-        match (c.slot, &c.sim) {
-            (Some(i), _) => {
-                let Some(&(k, _)) = crowds.members.get(&entity) else {
-                    continue;
-                };
-                let kind = crowds.kinds.get_mut(&k).expect("a member's kind exists");
-                let pose = kind.output(i, &c.written);
-                write_pose(c, pose, &mut transforms);
-            }
-            (None, Some(_)) => {
-                let sim = c.sim.take().expect("checked");
-                write_pose(c, &sim.pose().locals, &mut transforms);
-                c.sim = Some(sim);
-            }
-            (None, None) => {}
+        if let Some(sim) = c.sim.take() {
+            write_pose(c, &sim.pose().locals, &mut transforms);
+            c.sim = Some(sim);
         }
     }
-    diagnostics.add_measurement(&STEP_TIME, || started.elapsed().as_secs_f64() * 1e3);
+    let written = Instant::now();
+    let ms = |a: Instant, b: Instant| b.duration_since(a).as_secs_f64() * 1e3;
+    diagnostics.add_measurement(&STEP_TIME, || ms(started, written));
+    diagnostics.add_measurement(&READ_TIME, || ms(started, read));
+    diagnostics.add_measurement(&SOLVE_TIME, || ms(read, solved));
+    diagnostics.add_measurement(&WRITE_TIME, || ms(solved, written));
 }

@@ -523,3 +523,90 @@ fn chain_crowd_checks_the_input_limits_as_the_single_path() {
         assert!(e.contains(&format!("crowd character {first}:")), "{e}");
     }
 }
+
+/// `frame_parts` (the lane groups cut into shares the caller runs, as a game engine's
+/// task pool does) gives `frame`'s bits whatever the number of parts and the order or
+/// threads they run in, and runs no part on a bad time step.
+#[test]
+fn chain_crowd_parts_give_the_frame_bits() {
+    let (sk, settings) = builtin::bench_character(8, 6, 8);
+    let rig = Arc::new(ChainRig::new(&sk, &settings).unwrap());
+    let sk = Arc::new(sk);
+    let n = 37;
+    let run = |parts: usize, threads: bool| -> (Vec<u32>, f32) {
+        let mut crowd = ChainCrowd::new(sk.clone(), rig.clone()).unwrap();
+        for _ in 0..n {
+            crowd.add();
+        }
+        let mut inputs = vec![(Transform::IDENTITY, sk.rest().to_vec()); n];
+        let mut first = Vec::new();
+        for f in 0..200 {
+            for (i, (t, l)) in inputs.iter_mut().enumerate() {
+                *t = motion(&sk, 1, i, f, l);
+            }
+            let input = |i: usize| CrowdPose {
+                transform: inputs[i].0,
+                locals: &inputs[i].1,
+            };
+            if parts == 0 {
+                crowd.frame(1.0 / 60.0, input)
+            } else {
+                crowd.frame_parts(1.0 / 60.0, input, parts, |jobs| {
+                    if threads {
+                        std::thread::scope(|s| {
+                            for job in jobs {
+                                s.spawn(move || job.run());
+                            }
+                        });
+                    } else {
+                        let mut all: Vec<_> = jobs.collect();
+                        while let Some(job) = all.pop() {
+                            job.run();
+                        }
+                    }
+                })
+            }
+            .unwrap();
+            if f == 0 {
+                first = (0..rig.point_count())
+                    .map(|p| crowd.point(0, p).unwrap())
+                    .collect();
+            }
+        }
+        let moved = (0..rig.point_count())
+            .map(|p| crowd.point(0, p).unwrap().distance(first[p]))
+            .fold(0.0f32, f32::max);
+        let bits = (0..n)
+            .flat_map(|i| (0..rig.point_count()).map(move |p| (i, p)))
+            .flat_map(|(i, p)| crowd.point(i, p).unwrap().to_array())
+            .map(f32::to_bits)
+            .collect();
+        (bits, moved)
+    };
+    let (frame, moved) = run(0, false);
+    assert!(moved > 0.05, "the chains move ({moved} m)");
+    for parts in [1, 2, 3, 5] {
+        for threads in [false, true] {
+            assert_eq!(
+                frame,
+                run(parts, threads).0,
+                "{parts} parts, threads {threads}"
+            );
+        }
+    }
+    let mut crowd = ChainCrowd::new(sk.clone(), rig.clone()).unwrap();
+    crowd.add();
+    let rest = sk.rest().to_vec();
+    let mut ran = 0;
+    let e = crowd.frame_parts(
+        f32::NAN,
+        |_| CrowdPose {
+            transform: Transform::IDENTITY,
+            locals: &rest,
+        },
+        2,
+        |jobs| ran += jobs.count(),
+    );
+    assert!(e.is_err());
+    assert_eq!(ran, 0);
+}

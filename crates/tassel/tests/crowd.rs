@@ -494,3 +494,115 @@ fn vrm_crowd_removes_and_adds_characters() {
         crowd.frame(1.0 / 60.0, |_| unreachable!()).unwrap();
     }
 }
+
+/// `frame_parts` (the lane groups cut into shares the caller runs, as a game engine's
+/// task pool does) gives `frame`'s bits whatever the number of parts and the order or
+/// threads they run in, holds a bad character the same way, and runs no part on a bad
+/// time step.
+#[test]
+fn vrm_crowd_parts_give_the_frame_bits() {
+    let (sk, bones) = builtin::bench_vrm(8, 6, 8);
+    let rig = Arc::new(VrmRig::new(&sk, &bones, VrmOptions::default()).unwrap());
+    assert_eq!(rig.options.mode, VrmMode::Fixed);
+    let sk = Arc::new(sk);
+    let n = 37;
+    // parts: 0 = `frame` itself; else how many parts, run backwards (`odd`) or on
+    // scoped threads.
+    let run = |parts: usize, threads: bool| -> (Vec<u32>, usize, f32) {
+        let mut crowd = VrmCrowd::new(sk.clone(), rig.clone()).unwrap();
+        for _ in 0..n {
+            crowd.add();
+        }
+        let mut inputs = vec![(Transform::IDENTITY, sk.rest().to_vec()); n];
+        let mut held = 0;
+        for f in 0..200 {
+            for (i, (t, l)) in inputs.iter_mut().enumerate() {
+                *t = motion(&sk, 1, i, f, l);
+            }
+            if f == 50 {
+                inputs[20].1[1].rotation = Quat::from_xyzw(f32::NAN, 0.0, 0.0, 1.0);
+            }
+            let input = |i: usize| CrowdPose {
+                transform: inputs[i].0,
+                locals: &inputs[i].1,
+            };
+            let result = if parts == 0 {
+                crowd.frame(dt_at(f), input)
+            } else {
+                crowd.frame_parts(dt_at(f), input, parts, |jobs| {
+                    if threads {
+                        std::thread::scope(|s| {
+                            for job in jobs {
+                                s.spawn(move || job.run());
+                            }
+                        });
+                    } else {
+                        let mut all: Vec<_> = jobs.collect();
+                        while let Some(job) = all.pop() {
+                            job.run();
+                        }
+                    }
+                })
+            };
+            if f == 50 {
+                assert!(result
+                    .unwrap_err()
+                    .to_string()
+                    .contains("crowd character 20"));
+                assert_eq!(crowd.held().map(|(i, _)| i).collect::<Vec<_>>(), [20]);
+                held += 1;
+            } else {
+                result.unwrap();
+            }
+        }
+        let bits = (0..n)
+            .flat_map(|i| (0..rig.links.len()).map(move |k| (i, k)))
+            .flat_map(|(i, k)| crowd.rotation(i, k).unwrap().to_array())
+            .map(f32::to_bits)
+            .collect();
+        let swing = (0..n)
+            .flat_map(|i| {
+                rig.links
+                    .iter()
+                    .enumerate()
+                    .map(move |(k, l)| (i, k, l.joint))
+            })
+            .map(|(i, k, j)| {
+                crowd
+                    .rotation(i, k)
+                    .unwrap()
+                    .angle_between(sk.rest()[j].rotation)
+            })
+            .fold(0.0f32, f32::max);
+        (bits, held, swing)
+    };
+    let (frame, held, swing) = run(0, false);
+    assert_eq!(held, 1);
+    // The springs moved (the comparison is not of rest poses).
+    assert!(swing > 0.1, "largest swing {swing} rad");
+    for parts in [1, 2, 3, 5] {
+        for threads in [false, true] {
+            assert_eq!(
+                frame,
+                run(parts, threads).0,
+                "{parts} parts, threads {threads}"
+            );
+        }
+    }
+    // A bad time step: an error, and no part to run.
+    let mut crowd = VrmCrowd::new(sk.clone(), rig.clone()).unwrap();
+    crowd.add();
+    let rest = sk.rest().to_vec();
+    let mut ran = 0;
+    let e = crowd.frame_parts(
+        -1.0,
+        |_| CrowdPose {
+            transform: Transform::IDENTITY,
+            locals: &rest,
+        },
+        2,
+        |jobs| ran += jobs.count(),
+    );
+    assert!(e.is_err());
+    assert_eq!(ran, 0);
+}

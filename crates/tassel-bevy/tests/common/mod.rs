@@ -32,9 +32,30 @@ pub fn app(hz: f64) -> App {
 
 /// The same, reading files from `folder`.
 pub fn app_with_assets(hz: f64, folder: &str) -> App {
+    build_app(hz, folder, None)
+}
+
+/// A headless app at `hz` whose compute task pool (where the plugin reads and steps its
+/// crowds) has `threads` threads. Bevy's pools are made once per process: the first app
+/// of a process decides.
+pub fn app_on_threads(hz: f64, threads: usize) -> App {
+    build_app(hz, "assets", Some(threads))
+}
+
+fn build_app(hz: f64, folder: &str, threads: Option<usize>) -> App {
+    let mut tasks = bevy::app::TaskPoolPlugin::default();
+    if let Some(n) = threads {
+        tasks.task_pool_options.compute = bevy::app::TaskPoolThreadAssignmentPolicy {
+            min_threads: n,
+            max_threads: n,
+            percent: 1.0,
+            on_thread_spawn: None,
+            on_thread_destroy: None,
+        };
+    }
     let mut app = App::new();
     app.add_plugins((
-        MinimalPlugins,
+        MinimalPlugins.set(tasks),
         AssetPlugin {
             file_path: folder.to_string(),
             ..default()

@@ -15,8 +15,8 @@ mod vrm;
 
 pub use crate::lanes::{self, Isa, SimdUse};
 pub use crate::pose::CrowdPose;
-pub use chain::ChainCrowd;
-pub use vrm::VrmCrowd;
+pub use chain::{ChainCrowd, ChainCrowdPart};
+pub use vrm::{VrmCrowd, VrmCrowdPart};
 
 use crate::error::Error;
 use crate::math::Transform;

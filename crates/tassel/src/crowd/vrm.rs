@@ -322,11 +322,63 @@ impl VrmCrowd {
     where
         I: Fn(usize) -> CrowdPose<'a> + Sync,
     {
+        let threads = rayon::current_num_threads().max(1);
+        let Some((ctx, packs, scratch, chunk)) = self.prepare(dt, threads)? else {
+            return Ok(());
+        };
+        let (input, rest) = (&input, ctx.sk.rest());
+        packs
+            .par_chunks_mut(chunk)
+            .zip(scratch.par_iter_mut())
+            .enumerate()
+            .for_each(|(c, (packs, scratch))| {
+                run_part(&ctx, packs, scratch, c * chunk, input, rest)
+            });
+        self.result()
+    }
+
+    /// [`Self::frame`] with the lane groups cut into `parts` shares that `run` runs on the
+    /// caller's threads (a game engine's task pool, instead of rayon's) — each part
+    /// exactly once, in any order, in parallel or not — before it returns. The same bits
+    /// as [`Self::frame`], whatever the number of parts or threads. `run` gets no part
+    /// when the time step is bad (the error is returned) or the crowd is empty.
+    pub fn frame_parts<'a, I, R>(&mut self, dt: f32, input: I, parts: usize, run: R) -> Result<()>
+    where
+        I: Fn(usize) -> CrowdPose<'a> + Sync,
+        R: FnOnce(&mut dyn Iterator<Item = VrmCrowdPart<'_, I>>),
+    {
+        let Some((ctx, packs, scratch, chunk)) = self.prepare(dt, parts.max(1))? else {
+            return Ok(());
+        };
+        let (input, rest, ctx) = (&input, ctx.sk.rest(), &ctx);
+        run(&mut packs
+            .chunks_mut(chunk)
+            .zip(scratch.iter_mut())
+            .enumerate()
+            .map(|(c, (packs, scratch))| VrmCrowdPart {
+                ctx,
+                packs,
+                scratch,
+                first: c * chunk,
+                input,
+                rest,
+            }));
+        self.result()
+    }
+
+    /// A frame's shared part and its lane groups cut into `parts` chunks (each with its
+    /// scratch): `None` for an empty crowd.
+    #[allow(clippy::type_complexity)]
+    fn prepare(
+        &mut self,
+        dt: f32,
+        parts: usize,
+    ) -> Result<Option<(Ctx<'_>, &mut [Pack], &mut [Scratch], usize)>> {
         if !(dt.is_finite() && dt >= 0.0) {
             return Err(Error::InvalidTimeStep(dt));
         }
         if self.packs.is_empty() {
-            return Ok(());
+            return Ok(None);
         }
         // The update's time step: the frame's, or fixed mode's step.
         let h = match self.rig.options.mode {
@@ -337,8 +389,7 @@ impl VrmCrowd {
             self.stiffness_dt[k] = l.stiffness * h;
             self.external[k] = l.gravity * h;
         }
-        let threads = rayon::current_num_threads().max(1);
-        let chunk = self.packs.len().div_ceil(threads);
+        let chunk = self.packs.len().div_ceil(parts);
         let chunks = self.packs.len().div_ceil(chunk);
         while self.scratch.len() < chunks {
             self.scratch
@@ -353,24 +404,68 @@ impl VrmCrowd {
             dt,
             isa: Isa::of(self.simd),
         };
-        let input = &input;
-        let rest_pose = self.skeleton.rest();
-        self.packs
-            .par_chunks_mut(chunk)
-            .zip(self.scratch[..chunks].par_iter_mut())
-            .enumerate()
-            .for_each(|(c, (packs, scratch))| {
-                for (k, pack) in packs.iter_mut().enumerate() {
-                    let base = (c * chunk + k) * LANES;
-                    let kept = super::run_holding(pack, base, rest_pose, input, |pack, f| {
-                        ctx.run(pack, scratch, base, &f)
-                    });
-                    super::restore(pack, kept);
-                }
-            });
+        Ok(Some((
+            ctx,
+            &mut self.packs,
+            &mut self.scratch[..chunks],
+            chunk,
+        )))
+    }
+
+    /// The frame's result: the first held character's error.
+    fn result(&self) -> Result<()> {
         match self.packs.iter().find_map(|p| p.held.first()) {
             Some((_, e)) => Err(e.clone()),
             None => Ok(()),
         }
+    }
+}
+
+/// One share of a [`VrmCrowd`] frame's lane groups ([`VrmCrowd::frame_parts`]), to run on
+/// any thread.
+pub struct VrmCrowdPart<'f, I> {
+    ctx: &'f Ctx<'f>,
+    packs: &'f mut [Pack],
+    scratch: &'f mut Scratch,
+    /// The index of the first lane group.
+    first: usize,
+    input: &'f I,
+    rest: &'f [Transform],
+}
+
+impl<'a, I> VrmCrowdPart<'_, I>
+where
+    I: Fn(usize) -> CrowdPose<'a> + Sync,
+{
+    /// Steps this share's lane groups.
+    pub fn run(self) {
+        run_part(
+            self.ctx,
+            self.packs,
+            self.scratch,
+            self.first,
+            self.input,
+            self.rest,
+        );
+    }
+}
+
+/// Steps lane groups `packs` (the first is group `first`), holding bad characters.
+fn run_part<'a, I>(
+    ctx: &Ctx<'_>,
+    packs: &mut [Pack],
+    scratch: &mut Scratch,
+    first: usize,
+    input: &I,
+    rest: &[Transform],
+) where
+    I: Fn(usize) -> CrowdPose<'a> + Sync,
+{
+    for (k, pack) in packs.iter_mut().enumerate() {
+        let base = (first + k) * LANES;
+        let kept = super::run_holding(pack, base, rest, input, |pack, f| {
+            ctx.run(pack, scratch, base, &f)
+        });
+        super::restore(pack, kept);
     }
 }
