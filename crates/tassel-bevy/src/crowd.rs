@@ -4,7 +4,7 @@
 
 use crate::step::{to_tassel, world_of};
 use bevy::ecs::prelude::*;
-use bevy::platform::collections::HashMap;
+use bevy::platform::collections::{HashMap, HashSet};
 use bevy::prelude::{ChildOf, Transform as BevyTransform};
 use bevy::tasks::ComputeTaskPool;
 use std::sync::Arc;
@@ -34,9 +34,8 @@ pub(crate) struct Kind {
     /// The crowd changes only rotations of joints it lists, so the write-back copies those;
     /// with VRM node constraints, the whole pose is composed (`write_pose`) instead.
     pub(crate) whole_pose: bool,
-    /// Scratch for `write_pose` (whole-pose kinds).
-    pub(crate) scratch_locals: Vec<Transform>,
-    pub(crate) scratch_models: Vec<Transform>,
+    /// Each write part's scratch pose (locals, models).
+    pub(crate) scratch: Vec<(Vec<Transform>, Vec<Transform>)>,
     /// The joints written back (the kind's simulated joints, ascending; each has a bone
     /// entity, or the character would not have started).
     pub(crate) written: Vec<usize>,
@@ -55,6 +54,10 @@ pub(crate) struct Kind {
     pub(crate) spaces: Vec<Option<Entity>>,
     /// Members held this frame (bad input): their bones are not written.
     pub(crate) held: Vec<bool>,
+    /// Every member's written bones, each once; `shared_bones` once a bone came twice
+    /// (two characters over one hierarchy): then one thread writes.
+    pub(crate) bone_set: HashSet<Entity>,
+    pub(crate) shared_bones: bool,
 }
 
 impl Kind {
@@ -86,8 +89,7 @@ impl Kind {
                 roots: Vec::new(),
                 read,
                 whole_pose,
-                scratch_locals: sk.rest().to_vec(),
-                scratch_models: sk.rest().to_vec(),
+                scratch: Vec::new(),
                 written,
                 read_written,
                 read_bones: Vec::new(),
@@ -95,6 +97,8 @@ impl Kind {
                 wrote: Vec::new(),
                 spaces: Vec::new(),
                 held: Vec::new(),
+                bone_set: HashSet::new(),
+                shared_bones: false,
             })
         };
         Some(make())
@@ -125,6 +129,9 @@ impl Kind {
         self.locals.extend_from_slice(self.rig.skeleton().rest());
         self.roots.push(Transform::IDENTITY);
         self.read_bones.extend(self.read.iter().map(|&j| bones[j]));
+        for &e in &write {
+            self.shared_bones |= !self.bone_set.insert(e);
+        }
         self.write_bones.extend(write);
         self.wrote.extend(self.written.iter().map(|_| None));
         self.spaces.push(space);
@@ -142,6 +149,12 @@ impl Kind {
             Run::Vrm(c) => c.swap_remove(i),
             Run::Chains(c) => c.swap_remove(i),
         };
+        let w = self.written.len();
+        if !self.shared_bones {
+            for e in &self.write_bones[i * w..(i + 1) * w] {
+                self.bone_set.remove(e);
+            }
+        }
         self.members.swap_remove(i);
         self.roots.swap_remove(i);
         self.spaces.swap_remove(i);
@@ -228,49 +241,109 @@ impl Kind {
     }
 
     /// Writes every member's simulated bones (but a held member's: its bones keep their
-    /// animated pose).
+    /// animated pose), the members shared out over Bevy's compute task pool.
     pub(crate) fn write(&mut self, transforms: &mut Query<&mut BevyTransform>) {
-        let w = self.written.len();
-        for i in 0..self.members.len() {
-            if self.held[i] {
-                continue;
-            }
-            self.output(i);
-            let bones = &self.write_bones[i * w..(i + 1) * w];
-            let wrote = &mut self.wrote[i * w..(i + 1) * w];
-            for ((&j, &e), wrote) in self.written.iter().zip(bones).zip(wrote) {
-                if let Ok(mut t) = transforms.get_mut(e) {
-                    let l = self.scratch_locals[j];
-                    t.translation = l.translation;
-                    t.rotation = l.rotation;
-                    t.scale = l.scale;
-                    *wrote = Some(l);
-                }
-            }
+        let (members, w) = (self.members.len(), self.written.len());
+        if members == 0 || w == 0 {
+            return;
         }
+        let pool = ComputeTaskPool::get();
+        // Bones shared by two members (two characters over one hierarchy): one thread.
+        let parts = if self.shared_bones { 1 } else { parts(pool) };
+        let chunk = members.div_ceil(parts);
+        let rest = self.rig.skeleton().rest();
+        while self.scratch.len() < members.div_ceil(chunk) {
+            self.scratch.push((rest.to_vec(), rest.to_vec()));
+        }
+        let out = Output {
+            run: &self.run,
+            whole_pose: self.whole_pose,
+            locals: &self.locals,
+            written: &self.written,
+        };
+        let (bones, held) = (&self.write_bones, &self.held);
+        let transforms = &*transforms;
+        pool.scope(|s| {
+            for (c, (wrote, scratch)) in self
+                .wrote
+                .chunks_mut(chunk * w)
+                .zip(self.scratch.iter_mut())
+                .enumerate()
+            {
+                let first = c * chunk;
+                let count = wrote.len() / w;
+                let bones = &bones[first * w..(first + count) * w];
+                let held = &held[first..first + count];
+                let out = &out;
+                s.spawn(async move {
+                    for m in 0..count {
+                        if held[m] {
+                            continue;
+                        }
+                        let pose = out.pose(first + m, scratch);
+                        let bones = &bones[m * w..(m + 1) * w];
+                        let wrote = &mut wrote[m * w..(m + 1) * w];
+                        for ((&j, &e), wrote) in out.written.iter().zip(bones).zip(wrote) {
+                            // SAFETY: `transforms` is the step system's own
+                            // `Query<&mut Transform>`, borrowed exclusively for this pass:
+                            // nothing else reads or writes a `Transform` until the scope
+                            // ends. Every entity of `write_bones` appears once in the kind
+                            // (`shared_bones` is false, checked as members join; else one
+                            // part does it all), each part writes only its own members'
+                            // bones, and each `Mut` is dropped before the next: no two
+                            // live references to one component.
+                            #[allow(unsafe_code)]
+                            let t = unsafe { transforms.get_unchecked(e) };
+                            if let Ok(mut t) = t {
+                                let l = pose[j];
+                                t.translation = l.translation;
+                                t.rotation = l.rotation;
+                                t.scale = l.scale;
+                                *wrote = Some(l);
+                            }
+                        }
+                    }
+                });
+            }
+        });
     }
+}
 
-    /// Member `i`'s simulated local pose into `scratch_locals`: its animated locals with
-    /// the solvers' rotations. Only the `written` joints are fresh; the others hold
-    /// whatever an earlier member left (the write-back reads no other).
-    fn output(&mut self, i: usize) {
-        let n = self.joints();
+/// What a member's output pose is made of (shared by the write pass's parts).
+struct Output<'k> {
+    run: &'k Run,
+    whole_pose: bool,
+    locals: &'k [Transform],
+    written: &'k [usize],
+}
+
+impl Output<'_> {
+    /// Member `i`'s simulated local pose, in `scratch.0`: its animated locals with the
+    /// solvers' rotations. Only the `written` joints are fresh; the others hold whatever
+    /// an earlier member left (the write-back reads no other).
+    fn pose<'s>(
+        &self,
+        i: usize,
+        scratch: &'s mut (Vec<Transform>, Vec<Transform>),
+    ) -> &'s [Transform] {
+        let n = scratch.0.len();
         let input = &self.locals[i * n..(i + 1) * n];
+        let (out, models) = scratch;
         if self.whole_pose {
-            self.scratch_locals.copy_from_slice(input);
+            out.copy_from_slice(input);
         } else {
             // The crowd turns simulated joints only: their animated translation and scale
             // are the output's, and their rotation is written below.
-            for &j in &self.written {
-                self.scratch_locals[j] = input[j];
+            for &j in self.written {
+                out[j] = input[j];
             }
         }
-        let out = &mut self.scratch_locals;
-        let _ = match &self.run {
-            Run::Vrm(c) if self.whole_pose => c.write_pose(i, out, &mut self.scratch_models),
+        let _ = match self.run {
+            Run::Vrm(c) if self.whole_pose => c.write_pose(i, out, models),
             Run::Vrm(c) => c.write_rotations(i, out),
             Run::Chains(c) => c.write_rotations(i, out),
         };
+        out
     }
 }
 

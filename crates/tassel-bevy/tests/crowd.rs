@@ -322,3 +322,52 @@ fn step_settings_on_secondary_motion_reach_the_springs() {
         .expect("a bad step rate fails");
     assert!(failed.0.contains("step_rate 5"), "{}", failed.0);
 }
+
+/// Two characters over one hierarchy (a `SecondaryMotion` on an entity and another on its
+/// child, the bones below both): both step in one crowd and write the same bones, one
+/// after the other (the parallel write needs each bone once), the same values, as twins
+/// on their own sims write.
+#[test]
+fn two_characters_over_one_hierarchy_write_their_bones_in_turn() {
+    let (mut app, pairs, simulated) = crowd_app(2, 2, SimMode::Fixed);
+    let (skeleton, vrm) = tassel::builtin::bench_vrm(2, 9, 4);
+    let model = app
+        .world_mut()
+        .resource_mut::<Assets<TasselModel>>()
+        .add(TasselModel::new(skeleton.clone(), Some(vrm)));
+    let outer = app
+        .world_mut()
+        .spawn((Transform::default(), SecondaryMotion::new(model.clone())))
+        .id();
+    let inner = app
+        .world_mut()
+        .spawn((
+            Transform::default(),
+            ChildOf(outer),
+            SecondaryMotion::new(model.clone()),
+        ))
+        .id();
+    let bones = spawn_skeleton(app.world_mut(), &skeleton, inner);
+    let twin = app
+        .world_mut()
+        .spawn((
+            Transform::default(),
+            SecondaryMotion::new(model).without_crowd(),
+        ))
+        .id();
+    let twin_bones = spawn_skeleton(app.world_mut(), &skeleton, twin);
+    for frame in 0..40 {
+        app.update();
+        if frame > 3 {
+            compare(&app, &pairs, &simulated, frame);
+            let world = app.world();
+            for &j in &simulated {
+                let a = world.get::<Transform>(bones[j]).unwrap();
+                let b = world.get::<Transform>(twin_bones[j]).unwrap();
+                assert_eq!(bits(a), bits(b), "frame {frame}, joint {j}");
+            }
+        }
+    }
+    assert!(in_crowd(&app, outer) && in_crowd(&app, inner));
+    assert!(app.world().resource::<Errors>().0.is_empty());
+}
