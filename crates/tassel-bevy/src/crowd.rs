@@ -392,11 +392,11 @@ impl Members<'_> {
     }
 }
 
-/// How many shares to cut a pass into: one per thread of the pool, and one for the
-/// thread that waits in its `scope` (it runs tasks too). On two cores Bevy gives the
-/// compute pool one thread; the system's own thread is the second.
+/// How many shares to cut a pass into: one per thread of the pool. (The step system
+/// itself runs on one of them, and runs the scope's tasks while it waits; on two cores
+/// Bevy gives the compute pool one thread unless the app asks for more.)
 fn parts(pool: &ComputeTaskPool) -> usize {
-    pool.thread_num() + 1
+    pool.thread_num().max(1)
 }
 
 /// Removes run `i` (of `len` items) from `v`, the last run taking its place.
