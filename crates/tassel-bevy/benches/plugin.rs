@@ -48,24 +48,7 @@ fn app(n: usize, motion: Option<(SimMode, bool)>) -> (App, usize) {
             root.insert(if crowd { m } else { m.without_crowd() });
         }
         let root = root.id();
-        let mut entities: Vec<Entity> = Vec::with_capacity(skeleton.len());
-        for j in 0..skeleton.len() {
-            let parent = skeleton.parent(j).map_or(root, |p| entities[p]);
-            let r = skeleton.rest()[j];
-            let e = app
-                .world_mut()
-                .spawn((
-                    Name::new(skeleton.name(j).to_string()),
-                    Transform {
-                        translation: r.translation,
-                        rotation: r.rotation,
-                        scale: r.scale,
-                    },
-                    ChildOf(parent),
-                ))
-                .id();
-            entities.push(e);
-        }
+        tassel_bevy::spawn_skeleton(app.world_mut(), &skeleton, root);
     }
     for _ in 0..10 {
         app.update();

@@ -140,24 +140,7 @@ fn spawn_builtin(app: &mut App, o: &Options, with_motion: bool) -> usize {
             root.insert(m);
         }
         let root = root.id();
-        let mut entities: Vec<Entity> = Vec::with_capacity(skeleton.len());
-        for j in 0..skeleton.len() {
-            let parent = skeleton.parent(j).map_or(root, |p| entities[p]);
-            let r = skeleton.rest()[j];
-            let e = app
-                .world_mut()
-                .spawn((
-                    Name::new(skeleton.name(j).to_string()),
-                    Transform {
-                        translation: r.translation,
-                        rotation: r.rotation,
-                        scale: r.scale,
-                    },
-                    ChildOf(parent),
-                ))
-                .id();
-            entities.push(e);
-        }
+        tassel_bevy::spawn_skeleton(app.world_mut(), &skeleton, root);
     }
     joints
 }

@@ -50,6 +50,7 @@ mod controller;
 mod crowd;
 #[cfg(feature = "gizmos")]
 mod gizmos;
+mod spawn;
 mod step;
 #[cfg(feature = "gltf")]
 mod vrm_scene;
@@ -59,6 +60,7 @@ pub use character::{SecondaryMotion, TasselCharacter, TasselFailed};
 pub use controller::{CharacterController, TasselCollider, TasselLevel};
 #[cfg(feature = "gizmos")]
 pub use gizmos::TasselGizmosPlugin;
+pub use spawn::spawn_skeleton;
 pub use step::{READ_TIME, SOLVE_TIME, STEP_TIME, WRITE_TIME};
 pub use tassel;
 pub use tassel::dynamics::SimMode;

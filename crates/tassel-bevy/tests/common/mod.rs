@@ -83,22 +83,12 @@ fn collect_errors(mut messages: MessageReader<TasselError>, mut errors: ResMut<E
 #[derive(Component)]
 pub struct Bone(pub usize);
 
-/// Spawns `skeleton` at rest under `root`, each joint an entity with its name; returns the
-/// joints' entities.
+/// Spawns `skeleton` at rest under `root` ([`tassel_bevy::spawn_skeleton`]), each joint's
+/// entity marked with its [`Bone`]; returns the joints' entities.
 pub fn spawn_skeleton(world: &mut World, skeleton: &tassel::Skeleton, root: Entity) -> Vec<Entity> {
-    let mut entities: Vec<Entity> = Vec::with_capacity(skeleton.len());
-    for j in 0..skeleton.len() {
-        let parent = skeleton.parent(j).map_or(root, |p| entities[p]);
-        let rest = skeleton.rest()[j];
-        let e = world
-            .spawn((
-                Name::new(skeleton.name(j).to_string()),
-                bevy_transform(&rest),
-                Bone(j),
-                ChildOf(parent),
-            ))
-            .id();
-        entities.push(e);
+    let entities = tassel_bevy::spawn_skeleton(world, skeleton, root);
+    for (j, &e) in entities.iter().enumerate() {
+        world.entity_mut(e).insert(Bone(j));
     }
     entities
 }
