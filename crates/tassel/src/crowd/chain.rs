@@ -3,7 +3,7 @@
 //! spread over the rayon pool's threads. The lane-group frame itself is the chain
 //! solver's (`dynamics/chain/lanes/`), which one character's twin chains run too.
 
-use super::CrowdPose;
+use super::{CrowdPose, Frame, LaneStep, Part};
 use crate::dynamics::chain::compile::ChainRig;
 use crate::dynamics::chain::lanes::{any_planar, Ctx, LaneShape, Pack, Scratch};
 use crate::dynamics::path::CharacterPath;
@@ -13,7 +13,6 @@ use crate::math::Transform;
 use crate::pose::LocalToModelJob;
 use crate::skeleton::Skeleton;
 use glam::Vec3;
-use rayon::prelude::*;
 use std::sync::Arc;
 
 /// Many characters with the same bone chains, advanced together.
@@ -280,18 +279,9 @@ impl ChainCrowd {
     where
         I: Fn(usize) -> CrowdPose<'a> + Sync,
     {
-        let threads = rayon::current_num_threads().max(1);
-        let Some((ctx, packs, scratch, chunk)) = self.prepare(dt, threads)? else {
-            return Ok(());
-        };
-        let (input, rest) = (&input, ctx.sk.rest());
-        packs
-            .par_chunks_mut(chunk)
-            .zip(scratch.par_iter_mut())
-            .enumerate()
-            .for_each(|(c, (packs, scratch))| {
-                run_part(&ctx, packs, scratch, c * chunk, input, rest)
-            });
+        if let Some(f) = self.prepare(dt, rayon::current_num_threads().max(1))? {
+            f.run_rayon(&input);
+        }
         self.result()
     }
 
@@ -303,35 +293,17 @@ impl ChainCrowd {
     pub fn frame_parts<'a, I, R>(&mut self, dt: f32, input: I, parts: usize, run: R) -> Result<()>
     where
         I: Fn(usize) -> CrowdPose<'a> + Sync,
-        R: FnOnce(&mut dyn Iterator<Item = ChainCrowdPart<'_, I>>),
+        R: FnOnce(&mut dyn Iterator<Item = ChainCrowdPart<'_, '_, I>>),
     {
-        let Some((ctx, packs, scratch, chunk)) = self.prepare(dt, parts.max(1))? else {
-            return Ok(());
-        };
-        let (input, rest, ctx) = (&input, ctx.sk.rest(), &ctx);
-        run(&mut packs
-            .chunks_mut(chunk)
-            .zip(scratch.iter_mut())
-            .enumerate()
-            .map(|(c, (packs, scratch))| ChainCrowdPart {
-                ctx,
-                packs,
-                scratch,
-                first: c * chunk,
-                input,
-                rest,
-            }));
+        if let Some(mut f) = self.prepare(dt, parts.max(1))? {
+            f.run_parts(&input, ChainCrowdPart, run);
+        }
         self.result()
     }
 
     /// A frame's shared part and its lane groups cut into `parts` chunks (each with its
     /// scratch): `None` for an empty crowd.
-    #[allow(clippy::type_complexity)]
-    fn prepare(
-        &mut self,
-        dt: f32,
-        parts: usize,
-    ) -> Result<Option<(Ctx<'_>, &mut [Pack], &mut [Scratch], usize)>> {
+    fn prepare(&mut self, dt: f32, parts: usize) -> Result<Option<Frame<'_, Ctx<'_>>>> {
         if !(dt.is_finite() && dt >= 0.0) {
             return Err(Error::InvalidTimeStep(dt));
         }
@@ -344,20 +316,20 @@ impl ChainCrowd {
             self.scratch
                 .push(Scratch::new(&self.rig, self.skeleton.len()));
         }
-        let ctx = Ctx {
-            sk: &self.skeleton,
-            rig: &self.rig,
-            shapes: &self.shapes,
-            planar: any_planar(&self.rig),
-            dt,
-            isa: Isa::of(self.simd),
-        };
-        Ok(Some((
-            ctx,
-            &mut self.packs,
-            &mut self.scratch[..chunks],
+        Ok(Some(Frame {
+            ctx: Ctx {
+                sk: &self.skeleton,
+                rig: &self.rig,
+                shapes: &self.shapes,
+                planar: any_planar(&self.rig),
+                dt,
+                isa: Isa::of(self.simd),
+            },
+            packs: &mut self.packs,
+            scratch: &mut self.scratch[..chunks],
             chunk,
-        )))
+            rest: self.skeleton.rest(),
+        }))
     }
 
     /// The frame's result: the first held character's error.
@@ -371,57 +343,45 @@ impl ChainCrowd {
 
 /// One share of a [`ChainCrowd`] frame's lane groups ([`ChainCrowd::frame_parts`]), to
 /// run on any thread.
-pub struct ChainCrowdPart<'f, I> {
-    ctx: &'f Ctx<'f>,
-    packs: &'f mut [Pack],
-    scratch: &'f mut Scratch,
-    /// The index of the first lane group.
-    first: usize,
-    input: &'f I,
-    rest: &'f [Transform],
-}
+pub struct ChainCrowdPart<'f, 'c, I>(Part<'f, Ctx<'c>, I>);
 
-impl<'a, I> ChainCrowdPart<'_, I>
+impl<'a, I> ChainCrowdPart<'_, '_, I>
 where
     I: Fn(usize) -> CrowdPose<'a> + Sync,
 {
     /// Steps this share's lane groups.
     pub fn run(self) {
-        run_part(
-            self.ctx,
-            self.packs,
-            self.scratch,
-            self.first,
-            self.input,
-            self.rest,
-        );
+        self.0.run();
     }
 }
 
-/// Steps lane groups `packs` (the first is group `first`), holding bad characters.
-fn run_part<'a, I>(
-    ctx: &Ctx<'_>,
-    packs: &mut [Pack],
-    scratch: &mut Scratch,
-    first: usize,
-    input: &I,
-    rest: &[Transform],
-) where
-    I: Fn(usize) -> CrowdPose<'a> + Sync,
-{
-    for k in 0..packs.len() {
-        let (done, later) = packs.split_at_mut(k + 1);
-        let (pack, next) = (&mut done[k], later.first());
-        // The next group's state, on its way while this group runs (the step and the
-        // write-back ask for the rest of it as they go).
-        if let Some(next) = next {
-            next.prefetch_frame_state();
+impl LaneStep for Ctx<'_> {
+    type Pack = Pack;
+    type Scratch = Scratch;
+    fn run_groups<'a, I>(
+        &self,
+        packs: &mut [Pack],
+        scratch: &mut Scratch,
+        first: usize,
+        input: &I,
+        rest: &[Transform],
+    ) where
+        I: Fn(usize) -> CrowdPose<'a> + Sync,
+    {
+        for k in 0..packs.len() {
+            let (done, later) = packs.split_at_mut(k + 1);
+            let (pack, next) = (&mut done[k], later.first());
+            // The next group's state, on its way while this group runs (the step and the
+            // write-back ask for the rest of it as they go).
+            if let Some(next) = next {
+                next.prefetch_frame_state();
+            }
+            let base = (first + k) * LANES;
+            let kept = super::run_holding(pack, base, rest, input, |pack, f| {
+                self.gather(pack, scratch, base, &f)
+            });
+            self.step(pack, scratch, true, next);
+            super::restore(pack, kept);
         }
-        let base = (first + k) * LANES;
-        let kept = super::run_holding(pack, base, rest, input, |pack, f| {
-            ctx.gather(pack, scratch, base, &f)
-        });
-        ctx.step(pack, scratch, true, next);
-        super::restore(pack, kept);
     }
 }

@@ -21,6 +21,7 @@ pub use vrm::{VrmCrowd, VrmCrowdPart};
 use crate::error::Error;
 use crate::math::Transform;
 use crate::CharacterRig;
+use rayon::prelude::*;
 
 /// The crowd that can step characters of a kind ([`CrowdKind::of`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -150,5 +151,100 @@ fn swap_lanes<P: Group>(packs: &mut [P], i: usize, j: usize) {
         let b = packs[j / LANES].take(j % LANES);
         packs[i / LANES].put(i % LANES, &b);
         packs[j / LANES].put(j % LANES, &a);
+    }
+}
+
+/// A crowd's lane-group step as its frame runs it, a share of the groups at a time (the
+/// VRM and chain contexts).
+trait LaneStep: Sync {
+    type Pack: Send;
+    type Scratch: Send;
+    /// Steps lane groups `packs` (the first is group `first`), holding bad characters.
+    fn run_groups<'a, I>(
+        &self,
+        packs: &mut [Self::Pack],
+        scratch: &mut Self::Scratch,
+        first: usize,
+        input: &I,
+        rest: &[Transform],
+    ) where
+        I: Fn(usize) -> CrowdPose<'a> + Sync;
+}
+
+/// A frame ready to run: the step's context and the lane groups cut into chunks of
+/// `chunk`, each with its scratch.
+struct Frame<'f, C: LaneStep> {
+    ctx: C,
+    packs: &'f mut [C::Pack],
+    scratch: &'f mut [C::Scratch],
+    chunk: usize,
+    rest: &'f [Transform],
+}
+
+impl<C: LaneStep> Frame<'_, C> {
+    /// Runs every chunk on the current rayon pool's threads.
+    fn run_rayon<'a, I>(self, input: &I)
+    where
+        I: Fn(usize) -> CrowdPose<'a> + Sync,
+    {
+        let (ctx, chunk, rest) = (&self.ctx, self.chunk, self.rest);
+        self.packs
+            .par_chunks_mut(chunk)
+            .zip(self.scratch.par_iter_mut())
+            .enumerate()
+            .for_each(|(c, (packs, scratch))| {
+                ctx.run_groups(packs, scratch, c * chunk, input, rest)
+            });
+    }
+
+    /// Gives every chunk to `run` as a [`Part`] (wrapped by `wrap`), to run on the
+    /// caller's threads.
+    fn run_parts<'s, 'a, I, P, R>(
+        &'s mut self,
+        input: &'s I,
+        wrap: impl Fn(Part<'s, C, I>) -> P,
+        run: R,
+    ) where
+        I: Fn(usize) -> CrowdPose<'a> + Sync,
+        R: FnOnce(&mut dyn Iterator<Item = P>),
+    {
+        let (ctx, chunk, rest) = (&self.ctx, self.chunk, self.rest);
+        run(&mut self
+            .packs
+            .chunks_mut(chunk)
+            .zip(self.scratch.iter_mut())
+            .enumerate()
+            .map(|(c, (packs, scratch))| {
+                wrap(Part {
+                    ctx,
+                    packs,
+                    scratch,
+                    first: c * chunk,
+                    input,
+                    rest,
+                })
+            }));
+    }
+}
+
+/// One share of a crowd frame's lane groups, to run on any thread (inside the public
+/// [`VrmCrowdPart`] and [`ChainCrowdPart`]).
+struct Part<'f, C: LaneStep, I> {
+    ctx: &'f C,
+    packs: &'f mut [C::Pack],
+    scratch: &'f mut C::Scratch,
+    /// The index of the first lane group.
+    first: usize,
+    input: &'f I,
+    rest: &'f [Transform],
+}
+
+impl<'a, C: LaneStep, I> Part<'_, C, I>
+where
+    I: Fn(usize) -> CrowdPose<'a> + Sync,
+{
+    fn run(self) {
+        self.ctx
+            .run_groups(self.packs, self.scratch, self.first, self.input, self.rest);
     }
 }

@@ -3,7 +3,7 @@
 //! spread over the rayon pool's threads. The lane-group frame itself is the VRM solver's
 //! (`dynamics/vrm/lanes/`).
 
-use super::CrowdPose;
+use super::{CrowdPose, Frame, LaneStep, Part};
 use crate::dynamics::path::CharacterPath;
 use crate::dynamics::vrm::lanes::{Ctx, Pack, Plan, Scratch};
 use crate::dynamics::vrm::{VrmMode, VrmRig};
@@ -13,7 +13,6 @@ use crate::math::Transform;
 use crate::pose::LocalToModelJob;
 use crate::skeleton::Skeleton;
 use glam::{Quat, Vec3};
-use rayon::prelude::*;
 use std::sync::Arc;
 
 /// Many characters with the same VRM spring bones, advanced together.
@@ -322,18 +321,9 @@ impl VrmCrowd {
     where
         I: Fn(usize) -> CrowdPose<'a> + Sync,
     {
-        let threads = rayon::current_num_threads().max(1);
-        let Some((ctx, packs, scratch, chunk)) = self.prepare(dt, threads)? else {
-            return Ok(());
-        };
-        let (input, rest) = (&input, ctx.sk.rest());
-        packs
-            .par_chunks_mut(chunk)
-            .zip(scratch.par_iter_mut())
-            .enumerate()
-            .for_each(|(c, (packs, scratch))| {
-                run_part(&ctx, packs, scratch, c * chunk, input, rest)
-            });
+        if let Some(f) = self.prepare(dt, rayon::current_num_threads().max(1))? {
+            f.run_rayon(&input);
+        }
         self.result()
     }
 
@@ -345,35 +335,17 @@ impl VrmCrowd {
     pub fn frame_parts<'a, I, R>(&mut self, dt: f32, input: I, parts: usize, run: R) -> Result<()>
     where
         I: Fn(usize) -> CrowdPose<'a> + Sync,
-        R: FnOnce(&mut dyn Iterator<Item = VrmCrowdPart<'_, I>>),
+        R: FnOnce(&mut dyn Iterator<Item = VrmCrowdPart<'_, '_, I>>),
     {
-        let Some((ctx, packs, scratch, chunk)) = self.prepare(dt, parts.max(1))? else {
-            return Ok(());
-        };
-        let (input, rest, ctx) = (&input, ctx.sk.rest(), &ctx);
-        run(&mut packs
-            .chunks_mut(chunk)
-            .zip(scratch.iter_mut())
-            .enumerate()
-            .map(|(c, (packs, scratch))| VrmCrowdPart {
-                ctx,
-                packs,
-                scratch,
-                first: c * chunk,
-                input,
-                rest,
-            }));
+        if let Some(mut f) = self.prepare(dt, parts.max(1))? {
+            f.run_parts(&input, VrmCrowdPart, run);
+        }
         self.result()
     }
 
     /// A frame's shared part and its lane groups cut into `parts` chunks (each with its
     /// scratch): `None` for an empty crowd.
-    #[allow(clippy::type_complexity)]
-    fn prepare(
-        &mut self,
-        dt: f32,
-        parts: usize,
-    ) -> Result<Option<(Ctx<'_>, &mut [Pack], &mut [Scratch], usize)>> {
+    fn prepare(&mut self, dt: f32, parts: usize) -> Result<Option<Frame<'_, Ctx<'_>>>> {
         if !(dt.is_finite() && dt >= 0.0) {
             return Err(Error::InvalidTimeStep(dt));
         }
@@ -395,21 +367,21 @@ impl VrmCrowd {
             self.scratch
                 .push(Scratch::new(&self.plan, self.skeleton.len()));
         }
-        let ctx = Ctx {
-            sk: &self.skeleton,
-            rig: &self.rig,
-            plan: &self.plan,
-            stiffness_dt: &self.stiffness_dt,
-            external: &self.external,
-            dt,
-            isa: Isa::of(self.simd),
-        };
-        Ok(Some((
-            ctx,
-            &mut self.packs,
-            &mut self.scratch[..chunks],
+        Ok(Some(Frame {
+            ctx: Ctx {
+                sk: &self.skeleton,
+                rig: &self.rig,
+                plan: &self.plan,
+                stiffness_dt: &self.stiffness_dt,
+                external: &self.external,
+                dt,
+                isa: Isa::of(self.simd),
+            },
+            packs: &mut self.packs,
+            scratch: &mut self.scratch[..chunks],
             chunk,
-        )))
+            rest: self.skeleton.rest(),
+        }))
     }
 
     /// The frame's result: the first held character's error.
@@ -423,49 +395,37 @@ impl VrmCrowd {
 
 /// One share of a [`VrmCrowd`] frame's lane groups ([`VrmCrowd::frame_parts`]), to run on
 /// any thread.
-pub struct VrmCrowdPart<'f, I> {
-    ctx: &'f Ctx<'f>,
-    packs: &'f mut [Pack],
-    scratch: &'f mut Scratch,
-    /// The index of the first lane group.
-    first: usize,
-    input: &'f I,
-    rest: &'f [Transform],
-}
+pub struct VrmCrowdPart<'f, 'c, I>(Part<'f, Ctx<'c>, I>);
 
-impl<'a, I> VrmCrowdPart<'_, I>
+impl<'a, I> VrmCrowdPart<'_, '_, I>
 where
     I: Fn(usize) -> CrowdPose<'a> + Sync,
 {
     /// Steps this share's lane groups.
     pub fn run(self) {
-        run_part(
-            self.ctx,
-            self.packs,
-            self.scratch,
-            self.first,
-            self.input,
-            self.rest,
-        );
+        self.0.run();
     }
 }
 
-/// Steps lane groups `packs` (the first is group `first`), holding bad characters.
-fn run_part<'a, I>(
-    ctx: &Ctx<'_>,
-    packs: &mut [Pack],
-    scratch: &mut Scratch,
-    first: usize,
-    input: &I,
-    rest: &[Transform],
-) where
-    I: Fn(usize) -> CrowdPose<'a> + Sync,
-{
-    for (k, pack) in packs.iter_mut().enumerate() {
-        let base = (first + k) * LANES;
-        let kept = super::run_holding(pack, base, rest, input, |pack, f| {
-            ctx.run(pack, scratch, base, &f)
-        });
-        super::restore(pack, kept);
+impl LaneStep for Ctx<'_> {
+    type Pack = Pack;
+    type Scratch = Scratch;
+    fn run_groups<'a, I>(
+        &self,
+        packs: &mut [Pack],
+        scratch: &mut Scratch,
+        first: usize,
+        input: &I,
+        rest: &[Transform],
+    ) where
+        I: Fn(usize) -> CrowdPose<'a> + Sync,
+    {
+        for (k, pack) in packs.iter_mut().enumerate() {
+            let base = (first + k) * LANES;
+            let kept = super::run_holding(pack, base, rest, input, |pack, f| {
+                self.run(pack, scratch, base, &f)
+            });
+            super::restore(pack, kept);
+        }
     }
 }
