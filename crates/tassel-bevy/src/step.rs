@@ -182,13 +182,14 @@ pub(crate) fn step_characters(
     {
         let transforms = transforms.as_readonly();
         for (_, mut c) in &mut characters {
-            let c = &mut *c;
-            if c.sim.is_some() {
-                c.root = world_of(c.space, &transforms, &parents);
-                let mut locals = std::mem::take(&mut c.locals);
-                read_pose(c, &mut locals, &transforms);
-                c.locals = locals;
+            if c.sim.is_none() {
+                continue;
             }
+            let c = &mut *c;
+            c.root = world_of(c.space, &transforms, &parents);
+            let mut locals = std::mem::take(&mut c.locals);
+            read_pose(c, &mut locals, &transforms);
+            c.locals = locals;
         }
         for kind in crowds.kinds.values_mut() {
             kind.read(&transforms, &parents);
