@@ -1,0 +1,403 @@
+//! tassel-bevy's VRM spring bones against bevy_vrm1 0.10's spring-bone system, side by
+//! side in one run: four headless Bevy 0.19 apps (`MinimalPlugins`, transforms, 1/60 s a
+//! frame) with the same N avatars swaying on their roots, one with `TasselPlugin` in
+//! `fixed` mode (the default), one in `spec` mode (one update a frame, the work bevy_vrm1
+//! does), one with bevy_vrm1's `VrmSpringBonePlugin`, one with no secondary motion.
+//!
+//! The avatar is Tassel's bench avatar (`tassel::builtin::bench_vrm(2, 9, 4)`, as the
+//! plugin's `crowd` example): two strands of eight spring joints (stiffness 1, gravity 1,
+//! drag 0.5, hit radius 2 cm) and four colliders (spheres and capsules) on the root, spawned as a
+//! hierarchy of named entities. bevy_vrm1 gets the same springs as its own components
+//! (`SpringRoot` on each strand's first joint, `SpringJointProps` on each joint, a
+//! `ColliderShape` per collider): its loader needs the renderer and a VRM 1.0 file, so
+//! the avatar is given to it as its loader would have left it, and each strand ends in a
+//! tail entity 7 cm below the last joint (bevy_vrm1 has no virtual tail; Tassel's last
+//! joint swings toward the same point). As `VrmPlugin` does, the transforms are
+//! propagated before bevy_vrm1's springs (it reads `GlobalTransform`s); its spring set
+//! is put before Bevy's own propagation (so both apps propagate their simulated bones in
+//! the same frame).
+//!
+//! Timed: the spring step itself (between two marker systems around
+//! `TasselSystems::Step` and around `VrmSystemSets::SpringBone`), bevy_vrm1's step with
+//! the propagation it needs before it, and the whole `App::update`. Medians over rounds
+//! that alternate the apps, so that all see the same machine load.
+//!
+//! Run from the repository root:
+//! `cargo run --release --manifest-path bench/bevy_vrm1_vs_tassel/Cargo.toml -- [N] [--frames F] [--rounds R] [--threads T]`
+//! (`--threads`: Bevy's compute pool; its default on two cores is one thread).
+
+use bevy::prelude::*;
+use bevy::time::TimeUpdateStrategy;
+use bevy::transform::systems::{propagate_parent_transforms, sync_simple_transforms};
+use bevy::transform::TransformSystems;
+use bevy_vrm1::prelude::{
+    Capsule, ColliderShape, Sphere, SpringJointProps, SpringJoints, SpringRoot, VrmSystemSets,
+};
+use bevy_vrm1::vrm::spring_bone::{SpringCenterNode, SpringColliders, VrmSpringBonePlugin};
+use std::time::{Duration, Instant};
+use tassel::dynamics::vrm::{VrmShape, VrmSpringBones, VrmTail};
+use tassel::dynamics::SimMode;
+use tassel::Skeleton;
+use tassel_bevy::prelude::*;
+
+#[derive(Clone, Copy, PartialEq, Debug)]
+enum Engine {
+    TasselFixed,
+    TasselSpec,
+    BevyVrm1,
+    Nothing,
+}
+
+/// Sways its entity, `.0` seconds ahead on the motion (the `crowd` example's motion).
+#[derive(Component)]
+struct Sway(f32);
+
+fn sway(time: Res<Time>, mut q: Query<(&mut Transform, &Sway)>) {
+    for (mut t, s) in &mut q {
+        let x = time.elapsed_secs() + s.0;
+        t.translation.x = 0.3 * (2.0 * x).sin();
+        t.rotation = Quat::from_rotation_y(0.5 * (1.3 * x).sin());
+    }
+}
+
+/// When the timed part of the frame began and ended.
+#[derive(Resource, Default)]
+struct Marks {
+    before_propagation: Option<Instant>,
+    start: Option<Instant>,
+    end: Option<Instant>,
+}
+
+fn mark_before_propagation(mut m: ResMut<Marks>) {
+    m.before_propagation = Some(Instant::now());
+}
+fn mark_start(mut m: ResMut<Marks>) {
+    m.start = Some(Instant::now());
+}
+fn mark_end(mut m: ResMut<Marks>) {
+    m.end = Some(Instant::now());
+}
+
+/// Each avatar's joint entities (the skeleton's order), for the comparison at the end.
+#[derive(Resource, Default)]
+struct Avatars(Vec<Vec<Entity>>);
+
+fn app(engine: Engine, threads: Option<usize>) -> App {
+    let mut tasks = TaskPoolPlugin::default();
+    if let Some(n) = threads {
+        tasks.task_pool_options.compute.min_threads = n;
+        tasks.task_pool_options.compute.max_threads = n;
+    }
+    let mut app = App::new();
+    app.add_plugins((
+        MinimalPlugins.set(tasks),
+        AssetPlugin::default(),
+        TransformPlugin,
+    ))
+    .insert_resource(TimeUpdateStrategy::ManualDuration(Duration::from_secs_f64(
+        1.0 / 60.0,
+    )))
+    .init_resource::<Marks>()
+    .init_resource::<Avatars>()
+    .add_systems(Update, sway);
+    match engine {
+        Engine::TasselFixed | Engine::TasselSpec => {
+            app.add_plugins(TasselPlugin).add_systems(
+                PostUpdate,
+                (
+                    mark_start
+                        .after(TasselSystems::Bind)
+                        .before(TasselSystems::Step),
+                    mark_end.after(TasselSystems::Step),
+                ),
+            );
+        }
+        Engine::BevyVrm1 => {
+            app.add_plugins(VrmSpringBonePlugin)
+                // As `VrmPlugin` adds them: fresh `GlobalTransform`s for the springs.
+                .add_systems(
+                    PostUpdate,
+                    (sync_simple_transforms, propagate_parent_transforms)
+                        .chain()
+                        .in_set(VrmSystemSets::PropagateAfterExpressions)
+                        .before(VrmSystemSets::SpringBone),
+                )
+                .configure_sets(
+                    PostUpdate,
+                    VrmSystemSets::SpringBone.before(TransformSystems::Propagate),
+                )
+                .add_systems(
+                    PostUpdate,
+                    (
+                        mark_before_propagation.before(VrmSystemSets::PropagateAfterExpressions),
+                        mark_start
+                            .after(VrmSystemSets::PropagateAfterExpressions)
+                            .before(VrmSystemSets::SpringBone),
+                        mark_end
+                            .after(VrmSystemSets::SpringBone)
+                            .before(TransformSystems::Propagate),
+                    ),
+                );
+        }
+        Engine::Nothing => {}
+    }
+    app
+}
+
+/// N avatars: the skeleton as named entities under a swaying root, with each engine's
+/// components. Returns the number of simulated joints per avatar.
+fn spawn(app: &mut App, engine: Engine, n: usize, sk: &Skeleton, vrm: &VrmSpringBones) -> usize {
+    let model = (engine == Engine::TasselFixed || engine == Engine::TasselSpec).then(|| {
+        app.world_mut()
+            .resource_mut::<Assets<TasselModel>>()
+            .add(TasselModel::new(sk.clone(), Some(vrm.clone())))
+    });
+    let mut avatars = Vec::with_capacity(n);
+    for i in 0..n {
+        let mut root = app
+            .world_mut()
+            .spawn((Transform::default(), Sway(0.37 * i as f32)));
+        if let Some(model) = &model {
+            let mode = if engine == Engine::TasselSpec {
+                SimMode::Spec
+            } else {
+                SimMode::Fixed
+            };
+            root.insert(SecondaryMotion::new(model.clone()).with_mode(mode));
+        }
+        let root = root.id();
+        let entities = tassel_bevy::spawn_skeleton(app.world_mut(), &sk, root);
+        if engine == Engine::BevyVrm1 {
+            add_bevy_vrm1_springs(app, vrm, &entities);
+        }
+        avatars.push(entities);
+    }
+    app.world_mut().resource_mut::<Avatars>().0 = avatars;
+    vrm.springs.iter().map(|s| s.joints.len()).sum()
+}
+
+/// The avatar's springs as bevy_vrm1's components (what its loader inserts).
+fn add_bevy_vrm1_springs(app: &mut App, vrm: &VrmSpringBones, entities: &[Entity]) {
+    let colliders: Vec<(Entity, ColliderShape)> = vrm
+        .colliders
+        .iter()
+        .map(|c| match c.shape {
+            VrmShape::Sphere { offset, radius, .. } => (
+                entities[c.joint],
+                ColliderShape::Sphere(Sphere {
+                    offset: offset.to_array(),
+                    radius,
+                }),
+            ),
+            VrmShape::Capsule {
+                offset,
+                tail,
+                radius,
+                ..
+            } => (
+                entities[c.joint],
+                ColliderShape::Capsule(Capsule {
+                    offset: offset.to_array(),
+                    radius,
+                    tail: tail.to_array(),
+                }),
+            ),
+            VrmShape::Plane { .. } => unreachable!("the bench avatar has no plane"),
+        })
+        .collect();
+    for spring in &vrm.springs {
+        let mut joints: Vec<Entity> = spring.joints.iter().map(|j| entities[j.joint]).collect();
+        // bevy_vrm1 swings a joint toward the next entity of the list: the last joint's
+        // tail is an entity of its own.
+        let last = spring.joints.last().expect("a strand has joints");
+        match last.tail {
+            VrmTail::Local(offset) => {
+                let tail = app
+                    .world_mut()
+                    .spawn((
+                        Name::new("tail"),
+                        Transform::from_translation(offset),
+                        ChildOf(entities[last.joint]),
+                    ))
+                    .id();
+                joints.push(tail);
+            }
+            VrmTail::Joint(t) => joints.push(entities[t]),
+        }
+        for j in &spring.joints {
+            app.world_mut()
+                .entity_mut(entities[j.joint])
+                .insert(SpringJointProps {
+                    drag_force: j.drag_force,
+                    gravity_dir: j.gravity_dir,
+                    gravity_power: j.gravity_power,
+                    hit_radius: j.hit_radius,
+                    stiffness: j.stiffness,
+                });
+        }
+        app.world_mut().entity_mut(joints[0]).insert(SpringRoot {
+            joints: SpringJoints(joints),
+            colliders: SpringColliders(colliders.clone()),
+            center_node: SpringCenterNode(None),
+        });
+    }
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+/// Per frame: (whole update, timed step, step with the propagation before it), ms.
+fn run(app: &mut App, frames: usize, out: &mut [Vec<f64>; 3]) {
+    for _ in 0..frames {
+        let t = Instant::now();
+        app.update();
+        let whole = t.elapsed().as_secs_f64() * 1e3;
+        let m = app.world().resource::<Marks>();
+        let ms = |a: Option<Instant>, b: Option<Instant>| match (a, b) {
+            (Some(a), Some(b)) => b.duration_since(a).as_secs_f64() * 1e3,
+            _ => f64::NAN,
+        };
+        out[0].push(whole);
+        out[1].push(ms(m.start, m.end));
+        out[2].push(ms(m.before_propagation.or(m.start), m.end));
+    }
+}
+
+fn main() {
+    let mut n = 1000usize;
+    let mut frames = 100usize;
+    let mut rounds = 5usize;
+    let mut threads = None;
+    let mut args = std::env::args().skip(1);
+    while let Some(a) = args.next() {
+        let mut value = || -> usize {
+            args.next()
+                .and_then(|v| v.parse().ok())
+                .unwrap_or_else(|| panic!("{a} needs a number"))
+        };
+        match a.as_str() {
+            "--frames" => frames = value(),
+            "--rounds" => rounds = value(),
+            "--threads" => threads = Some(value()),
+            _ => n = a.parse().unwrap_or_else(|_| panic!("unknown argument {a}")),
+        }
+    }
+    let (sk, vrm) = tassel::builtin::bench_vrm(2, 9, 4);
+    let engines = [
+        Engine::TasselFixed,
+        Engine::TasselSpec,
+        Engine::BevyVrm1,
+        Engine::Nothing,
+    ];
+    let mut apps: Vec<App> = Vec::new();
+    let mut joints = 0;
+    for &e in &engines {
+        let mut a = app(e, threads);
+        joints = spawn(&mut a, e, n, &sk, &vrm);
+        // Bound, initialised and warm.
+        for _ in 0..30 {
+            a.update();
+        }
+        apps.push(a);
+    }
+    let tassel_bound = |a: &mut App| {
+        let w = a.world_mut();
+        w.query::<&TasselCharacter>()
+            .iter(w)
+            .filter(|c| c.in_crowd())
+            .count()
+    };
+    for a in &mut apps[..2] {
+        assert_eq!(tassel_bound(a), n, "every Tassel character in its crowd");
+    }
+    let mut times: Vec<[Vec<f64>; 3]> = engines.iter().map(|_| Default::default()).collect();
+    for _ in 0..rounds {
+        for (a, t) in apps.iter_mut().zip(&mut times) {
+            run(a, frames, t);
+        }
+    }
+    // Both follow the specification: after the same frames, Tassel's `spec` mode and
+    // bevy_vrm1 should agree on where the springs point.
+    let rotations = |a: &mut App| -> Vec<Quat> {
+        let avatars = std::mem::take(&mut a.world_mut().resource_mut::<Avatars>().0);
+        let w = a.world_mut();
+        let mut q = w.query::<&Transform>();
+        let r = avatars
+            .iter()
+            .flat_map(|e| {
+                vrm.springs
+                    .iter()
+                    .flat_map(move |s| s.joints.iter().map(move |j| e[j.joint]))
+            })
+            .map(|e| q.get(w, e).expect("a joint").rotation)
+            .collect();
+        a.world_mut().resource_mut::<Avatars>().0 = avatars;
+        r
+    };
+    let (spec, theirs) = (rotations(&mut apps[1]), rotations(&mut apps[2]));
+    let worst = spec
+        .iter()
+        .zip(&theirs)
+        .map(|(a, b)| a.angle_between(*b))
+        .fold(0.0f32, f32::max);
+    let swing = spec
+        .iter()
+        .zip(
+            &vrm.springs
+                .iter()
+                .flat_map(|s| s.joints.iter().map(|j| sk.rest()[j.joint].rotation))
+                .cycle()
+                .take(spec.len())
+                .collect::<Vec<_>>(),
+        )
+        .map(|(a, b)| a.angle_between(*b))
+        .fold(0.0f32, f32::max);
+
+    let m: Vec<[f64; 3]> = times
+        .into_iter()
+        .map(|[a, b, c]| [median(a), median(b), median(c)])
+        .collect();
+    let per_joint = |ms: f64| ms * 1e6 / (n * joints) as f64;
+    println!(
+        "{n} avatars x {joints} spring joints, 4 colliders; {rounds} rounds x {frames} frames, apps alternating; {} compute threads; medians",
+        bevy::tasks::ComputeTaskPool::get().thread_num()
+    );
+    println!("| app | spring step, ms per frame | ns per joint-step | whole frame, ms |");
+    println!("|---|---|---|---|");
+    for (e, [whole, step, with_prop]) in engines.iter().zip(&m) {
+        match e {
+            Engine::Nothing => println!("| no secondary motion | - | - | {whole:.3} |"),
+            Engine::BevyVrm1 => println!(
+                "| bevy_vrm1 0.10 `update_spring_bones` (+ the propagation it needs before it) | {step:.3} ({with_prop:.3}) | {:.1} ({:.1}) | {whole:.3} |",
+                per_joint(*step),
+                per_joint(*with_prop)
+            ),
+            _ => println!(
+                "| tassel-bevy, `{}` | {step:.3} | {:.1} | {whole:.3} |",
+                if *e == Engine::TasselFixed { "fixed" } else { "spec" },
+                per_joint(*step)
+            ),
+        }
+    }
+    let ratio = |i: usize| m[2][1] / m[i][1];
+    let ratio_prop = |i: usize| m[2][2] / m[i][1];
+    println!(
+        "tassel-bevy per joint: fixed {:.2}x, spec {:.2}x bevy_vrm1's spring system ({:.2}x / {:.2}x with its propagation)",
+        ratio(0),
+        ratio(1),
+        ratio_prop(0),
+        ratio_prop(1)
+    );
+    println!(
+        "whole frame against no secondary motion: tassel fixed {:.2}x, spec {:.2}x, bevy_vrm1 {:.2}x",
+        m[0][0] / m[3][0],
+        m[1][0] / m[3][0],
+        m[2][0] / m[3][0]
+    );
+    println!(
+        "tassel `spec` vs bevy_vrm1 after {} frames: largest angle between their joint rotations {worst:.2e} rad (the joints swing up to {swing:.2} rad from rest)",
+        30 + rounds * frames
+    );
+}
