@@ -23,7 +23,7 @@
 //! that alternate the apps, so that all see the same machine load.
 //!
 //! Run from the repository root:
-//! `cargo run --release --manifest-path bench/bevy_vrm1_vs_tassel/Cargo.toml -- [N] [--frames F] [--rounds R] [--threads T]`
+//! `cargo run --release --manifest-path bench/bevy_vrm1_vs_tassel/Cargo.toml -- [N] [--frames F] [--rounds R] [--threads T] [--no-colliders]`
 //! (`--threads`: Bevy's compute pool; its default on two cores is one thread).
 
 use bevy::prelude::*;
@@ -270,6 +270,7 @@ fn main() {
     let mut frames = 100usize;
     let mut rounds = 5usize;
     let mut threads = None;
+    let mut colliders = true;
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         let mut value = || -> usize {
@@ -281,10 +282,18 @@ fn main() {
             "--frames" => frames = value(),
             "--rounds" => rounds = value(),
             "--threads" => threads = Some(value()),
+            "--no-colliders" => colliders = false,
             _ => n = a.parse().unwrap_or_else(|_| panic!("unknown argument {a}")),
         }
     }
-    let (sk, vrm) = tassel::builtin::bench_vrm(2, 9, 4);
+    let (sk, mut vrm) = tassel::builtin::bench_vrm(2, 9, 4);
+    if !colliders {
+        vrm.colliders.clear();
+        vrm.collider_groups.clear();
+        for s in &mut vrm.springs {
+            s.collider_groups.clear();
+        }
+    }
     let engines = [
         Engine::TasselFixed,
         Engine::TasselSpec,
