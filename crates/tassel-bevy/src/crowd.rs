@@ -2,7 +2,7 @@
 //! rig ([`CrowdKind::of`]), with the characters' animated input and the simulated output in
 //! flat buffers, one slot per character.
 
-use crate::step::{to_tassel, world_of};
+use crate::step::{to_bevy, to_tassel, world_of};
 use bevy::ecs::prelude::*;
 use bevy::platform::collections::{HashMap, HashSet};
 use bevy::prelude::{ChildOf, Transform as BevyTransform};
@@ -295,11 +295,8 @@ impl Kind {
                             #[allow(unsafe_code)]
                             let t = unsafe { transforms.get_unchecked(e) };
                             if let Ok(mut t) = t {
-                                let l = pose[j];
-                                t.translation = l.translation;
-                                t.rotation = l.rotation;
-                                t.scale = l.scale;
-                                *wrote = Some(l);
+                                *t = to_bevy(&pose[j]);
+                                *wrote = Some(pose[j]);
                             }
                         }
                     }

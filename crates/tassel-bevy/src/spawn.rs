@@ -1,7 +1,8 @@
 //! A skeleton made in code (or read by `tassel_gltf`) spawned as Bevy entities.
 
+use crate::step::to_bevy;
 use bevy::ecs::prelude::*;
-use bevy::prelude::{ChildOf, Name, Transform};
+use bevy::prelude::{ChildOf, Name};
 use tassel::Skeleton;
 
 /// Spawns `skeleton` at rest below `parent`: one entity per joint, named as the joint (as
@@ -13,15 +14,10 @@ pub fn spawn_skeleton(world: &mut World, skeleton: &Skeleton, parent: Entity) ->
     let mut entities: Vec<Entity> = Vec::with_capacity(skeleton.len());
     for j in 0..skeleton.len() {
         let up = skeleton.parent(j).map_or(parent, |p| entities[p]);
-        let rest = skeleton.rest()[j];
         let e = world
             .spawn((
                 Name::new(skeleton.name(j).to_string()),
-                Transform {
-                    translation: rest.translation,
-                    rotation: rest.rotation,
-                    scale: rest.scale,
-                },
+                to_bevy(&skeleton.rest()[j]),
                 ChildOf(up),
             ))
             .id();

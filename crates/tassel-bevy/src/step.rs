@@ -1,12 +1,14 @@
 //! One frame of every bound character: read the animated bone `Transform`s, step, write
 //! the simulated bones back (before Bevy propagates transforms).
 //!
-//! Three passes. **Read**: each character's animated bones and its world transform into
-//! its input buffer (its own, or its slot of its kind's crowd). **Step**: every crowd
-//! (SIMD lanes, the rayon pool's threads), and the characters on their own
-//! `CharacterSim` in parallel on Bevy's compute pool. **Write**: each character's
-//! simulated bones back to their entities. Only the passes that touch `Transform`s are
-//! sequential, and they touch only the bones a solver reads or writes.
+//! Three passes, all on Bevy's compute task pool. **Read**: each character's animated
+//! bones and its world transform into its input buffer (its own, or its slot of its
+//! kind's crowd: `Kind::read`, members shared out over the pool). **Step**: every crowd
+//! (SIMD lanes, its lane groups shared out with `frame_parts`), and the characters on
+//! their own `CharacterSim` in parallel. **Write**: each character's simulated bones back
+//! to their entities (`Kind::write` for crowds, shared out too). Only the bones a solver
+//! reads or writes are touched; the characters on their own sims are read and written
+//! one after another.
 
 use crate::character::TasselCharacter;
 use crate::crowd::Crowds;
@@ -43,6 +45,15 @@ pub(crate) fn step_time_diagnostics() -> [Diagnostic; 4] {
 /// Bevy's `Transform` as Tassel's (the same glam types).
 pub(crate) fn to_tassel(t: &Transform) -> tassel::Transform {
     tassel::Transform::new(t.translation, t.rotation, t.scale)
+}
+
+/// Tassel's `Transform` as Bevy's.
+pub(crate) fn to_bevy(t: &tassel::Transform) -> Transform {
+    Transform {
+        translation: t.translation,
+        rotation: t.rotation,
+        scale: t.scale,
+    }
 }
 
 /// The world transform of `entity` from this frame's local `Transform`s (not last frame's
@@ -109,11 +120,8 @@ fn write_pose(
 ) {
     for (&(j, e), wrote) in c.written.iter().zip(&mut c.wrote) {
         if let Ok(mut t) = transforms.get_mut(e) {
-            let l = pose[j];
-            t.translation = l.translation;
-            t.rotation = l.rotation;
-            t.scale = l.scale;
-            *wrote = Some(l);
+            *t = to_bevy(&pose[j]);
+            *wrote = Some(pose[j]);
         }
     }
 }

@@ -552,18 +552,7 @@ fn chain_crowd_parts_give_the_frame_bits() {
                 crowd.frame(1.0 / 60.0, input)
             } else {
                 crowd.frame_parts(1.0 / 60.0, input, parts, |jobs| {
-                    if threads {
-                        std::thread::scope(|s| {
-                            for job in jobs {
-                                s.spawn(move || job.run());
-                            }
-                        });
-                    } else {
-                        let mut all: Vec<_> = jobs.collect();
-                        while let Some(job) = all.pop() {
-                            job.run();
-                        }
-                    }
+                    common::run_parts(jobs, threads, |job| job.run())
                 })
             }
             .unwrap();

@@ -1,6 +1,9 @@
 //! The crowd path against the single-character path: the same bits, frame after frame,
 //! for every character, whatever the thread count.
 
+mod common;
+
+use common::transform_bits as bits;
 use glam::{Quat, Vec3};
 use std::sync::Arc;
 use tassel::crowd::{CrowdPose, SimdUse, VrmCrowd};
@@ -31,21 +34,6 @@ fn dt_at(f: usize) -> f32 {
         300 => 0.25,
         _ => 1.0 / 60.0,
     }
-}
-
-fn bits(t: &Transform) -> [u32; 10] {
-    let mut b = [0u32; 10];
-    for (k, v) in t
-        .translation
-        .to_array()
-        .into_iter()
-        .chain(t.rotation.to_array())
-        .chain(t.scale.to_array())
-        .enumerate()
-    {
-        b[k] = v.to_bits();
-    }
-    b
 }
 
 /// `n` characters through `frames` frames in a crowd and one `CharacterSim` each: every
@@ -506,8 +494,7 @@ fn vrm_crowd_parts_give_the_frame_bits() {
     assert_eq!(rig.options.mode, VrmMode::Fixed);
     let sk = Arc::new(sk);
     let n = 37;
-    // parts: 0 = `frame` itself; else how many parts, run backwards (`odd`) or on
-    // scoped threads.
+    // parts: 0 = `frame` itself; else how many parts, run backwards or on scoped threads.
     let run = |parts: usize, threads: bool| -> (Vec<u32>, usize, f32) {
         let mut crowd = VrmCrowd::new(sk.clone(), rig.clone()).unwrap();
         for _ in 0..n {
@@ -530,18 +517,7 @@ fn vrm_crowd_parts_give_the_frame_bits() {
                 crowd.frame(dt_at(f), input)
             } else {
                 crowd.frame_parts(dt_at(f), input, parts, |jobs| {
-                    if threads {
-                        std::thread::scope(|s| {
-                            for job in jobs {
-                                s.spawn(move || job.run());
-                            }
-                        });
-                    } else {
-                        let mut all: Vec<_> = jobs.collect();
-                        while let Some(job) = all.pop() {
-                            job.run();
-                        }
-                    }
+                    common::run_parts(jobs, threads, |job| job.run())
                 })
             };
             if f == 50 {

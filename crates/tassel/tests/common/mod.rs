@@ -340,3 +340,25 @@ pub mod kawaii {
         (d2 / n as f64).sqrt()
     }
 }
+
+/// Runs a crowd frame's parts (`frame_parts`) as a game engine's task pool might: each on
+/// a scoped thread of its own (`threads`), or all on this thread, the last first.
+pub fn run_parts<J: Send>(
+    jobs: &mut dyn Iterator<Item = J>,
+    threads: bool,
+    run: impl Fn(J) + Sync,
+) {
+    if threads {
+        let run = &run;
+        std::thread::scope(|s| {
+            for job in jobs {
+                s.spawn(move || run(job));
+            }
+        });
+    } else {
+        let mut all: Vec<J> = jobs.collect();
+        while let Some(job) = all.pop() {
+            run(job);
+        }
+    }
+}
