@@ -11,19 +11,34 @@ import { CHAINS, JOINTS_PER_CHAIN, springRigGlb } from './rig.mjs';
 const JOINTS = CHAINS * JOINTS_PER_CHAIN;
 
 // What is measured: three-vrm's manager per character; Tassel's manager per character
-// (one WebAssembly call each); Tassel's crowd (one call a frame for all characters).
+// (one WebAssembly call each); Tassel's crowd (one call a frame for all characters); the
+// crowd leaving matrixWorld to the renderer (`worldMatrices: false`); and the crowd's
+// WebAssembly step alone, without the transfer (its frame call on the buffers the last
+// update filled: what the transfer to and from three.js adds is the difference).
 const KINDS = {
   'three-vrm 3.5.5': { mode: null, crowd: false },
   'Tassel three-vrm': { mode: 'three-vrm', crowd: false },
   'Tassel fixed': { mode: 'fixed', crowd: false },
   'crowd three-vrm': { mode: 'three-vrm', crowd: true },
   'crowd fixed': { mode: 'fixed', crowd: true },
+  'crowd three-vrm, no matrixWorld': { mode: 'three-vrm', crowd: true, options: { worldMatrices: false } },
+  'crowd three-vrm, step alone': { mode: 'three-vrm', crowd: true, stepAlone: true },
 };
 
+/** The crowd's WebAssembly frame alone (the buffers as its last update left them). This
+ *  reaches into TasselCrowd's private fields: a measurement, not an API. */
+function stepAlone(crowd, dt) {
+  const [rp, lp, op] = crowd._buffers;
+  const n = crowd.size;
+  const code = crowd._tassel.x.tassel_crowd_frame(crowd._ptr, rp[0], n * 10, lp[0], n * crowd._read.length * 10,
+    op[0], n * crowd._written.length * 10, dt);
+  if (code !== 0) throw new Error(`the crowd's frame failed (${code})`);
+}
+
 async function characters(kind, n, ctx) {
-  const { mode, crowd: inCrowd } = KINDS[kind];
+  const { mode, crowd: inCrowd, options = {}, stepAlone: alone = false } = KINDS[kind];
   const bytes = springRigGlb();
-  const crowd = inCrowd ? await ctx.TasselCrowd.fromBytes(bytes, { mode }) : null;
+  const crowd = inCrowd ? await ctx.TasselCrowd.fromBytes(bytes, { mode, ...options }) : null;
   const chars = [];
   for (let i = 0; i < n; i++) {
     const { gltf, manager } = await ctx.loadGltfBytes(bytes);
@@ -34,12 +49,18 @@ async function characters(kind, n, ctx) {
     gltf.scene.updateMatrixWorld(true);
     chars.push({ scene: gltf.scene, manager: m, x: i * 0.7 });
   }
-  return { chars, crowd };
+  // The step alone steps from the pose of one real update.
+  if (alone) crowd.update(1 / 60);
+  return { chars, crowd, alone };
 }
 
 function run(set, frames, dt, t0) {
-  const { chars, crowd } = set;
+  const { chars, crowd, alone } = set;
   const start = performance.now();
+  if (alone) {
+    for (let f = 0; f < frames; f++) stepAlone(crowd, dt);
+    return performance.now() - start;
+  }
   for (let f = 0; f < frames; f++) {
     const t = t0 + f * dt;
     for (const c of chars) {

@@ -159,11 +159,11 @@ class BoneParts {
   }
 
   /** Writes part `k`'s local transform from `v[at..at + 10]` and refreshes its `matrix`
-   *  and `matrixWorld` (from its parent's), as three-vrm leaves its spring bones. The
-   *  quaternion is written through its fields: three.js's setter would also recompute the
-   *  Euler `rotation`, which costs more than the whole spring step; `syncRotation` asks
-   *  for it. */
-  write(k, v, at, syncRotation) {
+   *  and (with `world`) its `matrixWorld` from its parent's, as three-vrm leaves its spring
+   *  bones. The quaternion is written through its fields: three.js's setter would also
+   *  recompute the Euler `rotation`, which costs more than the whole spring step;
+   *  `syncRotation` asks for it. */
+  write(k, v, at, syncRotation, world) {
     const tx = v[at], ty = v[at + 1], tz = v[at + 2];
     const x = v[at + 3], y = v[at + 4], z = v[at + 5], w = v[at + 6];
     const sx = v[at + 7], sy = v[at + 8], sz = v[at + 9];
@@ -185,6 +185,7 @@ class BoneParts {
     m[4] = m4; m[5] = m5; m[6] = m6; m[7] = 0;
     m[8] = m8; m[9] = m9; m[10] = m10; m[11] = 0;
     m[12] = tx; m[13] = ty; m[14] = tz; m[15] = 1;
+    if (!world) return;
     const r = this.w[k];
     const a = this.pw[k];
     if (a === null) {
@@ -244,6 +245,49 @@ function parentsFirst(joints, depths) {
   return [...joints].sort((a, b) => depths[a] - depths[b] || a - b);
 }
 
+/** The order a character's bones are written in, parents first: entries `k >= 0` write
+ *  `parts`' k-th joint (given in `order`); with `world`, entries `-1 - i` refresh the
+ *  matrixWorld of `refresh[i]`, an object between a written bone and the scene that is not
+ *  written itself (a spring chain's non-simulated parent and its ancestors), so that every
+ *  matrixWorld written is made from its parent's of this frame, not the last render's.
+ *  Taken from the objects' parents when the character is made. */
+function writePlan(parts, order, scene, world) {
+  const written = new Set(parts.object.filter((o) => o));
+  const refresh = [];
+  if (world) {
+    const seen = new Set();
+    for (const o of parts.object) {
+      if (!o) continue;
+      for (let a = o.parent; a && a !== scene && !written.has(a) && !seen.has(a); a = a.parent) {
+        seen.add(a);
+        refresh.push(a);
+      }
+    }
+  }
+  const depth = (o) => {
+    let d = 0;
+    for (let a = o.parent; a; a = a.parent) d++;
+    return d;
+  };
+  const entries = [];
+  order.forEach((k, rank) => {
+    const o = parts.object[k];
+    if (o) entries.push({ e: k, depth: depth(o), rank });
+  });
+  refresh.forEach((o, i) => entries.push({ e: -1 - i, depth: depth(o), rank: -1 }));
+  entries.sort((a, b) => a.depth - b.depth || a.rank - b.rank);
+  return { plan: Int32Array.from(entries, (x) => x.e), refresh };
+}
+
+/** Writes a character's bones by its plan (see writePlan): joint k from `v[base + at(k)..]`. */
+function writeBones(parts, { plan, refresh }, v, base, at, syncRotation, world) {
+  for (let i = 0; i < plan.length; i++) {
+    const e = plan[i];
+    if (e >= 0) parts.write(e, v, base + at[e], syncRotation, world);
+    else refresh[-1 - e].updateWorldMatrix(false, false);
+  }
+}
+
 /** One character stepped by Tassel: what both public classes drive. */
 class Driver {
   constructor(tassel, ptr, gltf, options) {
@@ -253,6 +297,7 @@ class Driver {
     this.scene = gltf.scene;
     this.onError = options.onError ?? null;
     this.syncRotation = options.syncRotation ?? false;
+    this.worldMatrices = options.worldMatrices ?? true;
     this.lastError = null;
     this.mode = tassel.string(x.tassel_mode(ptr));
     const { n, depths } = jointTable(tassel, ptr);
@@ -262,6 +307,9 @@ class Driver {
     this.written = Int32Array.from(parentsFirst(simulated.filter((j) => this.objects[j] !== null), depths));
     this.all = new BoneParts(this.objects, Array.from({ length: n }, (_, j) => j));
     this.out = new BoneParts(this.objects, Array.from(this.written));
+    this.plan = writePlan(this.out, Array.from(this.written, (_, k) => k), this.scene, this.worldMatrices);
+    // Where written joint k's transform is in the joints' buffer.
+    this.writtenAt = Int32Array.from(this.written, (j) => j * FLOATS);
     this.isWritten = new Uint8Array(n);
     for (const j of this.written) this.isWritten[j] = 1;
     // Transforms cross in one buffer of the module's memory: the root, then every joint.
@@ -308,9 +356,8 @@ class Driver {
   /** The written bones go back to their animated pose and every solver starts again from
    *  it on the next update (three-vrm's reset). */
   reset() {
-    for (let k = 0; k < this.written.length; k++) {
-      this.out.write(k, this.animated, this.written[k] * FLOATS, this.syncRotation);
-    }
+    this.scene.updateWorldMatrix(true, false);
+    writeBones(this.out, this.plan, this.animated, 0, this.writtenAt, this.syncRotation, this.worldMatrices);
     this.hasWritten = false;
     this.tassel.x.tassel_reset(this.ptr);
   }
@@ -357,14 +404,12 @@ class Driver {
     }
     this.lastError = null;
     const out = this.locals();
-    const written = this.written;
-    const parts = this.out;
-    const syncRotation = this.syncRotation;
-    for (let k = 0; k < written.length; k++) {
-      const at = written[k] * FLOATS;
+    const writtenAt = this.writtenAt;
+    for (let k = 0; k < writtenAt.length; k++) {
+      const at = writtenAt[k];
       for (let i = 0; i < FLOATS; i++) wrote[at + i] = out[at + i];
-      parts.write(k, out, at, syncRotation);
     }
+    writeBones(this.out, this.plan, out, 0, writtenAt, this.syncRotation, this.worldMatrices);
     this.hasWritten = true;
     return true;
   }
@@ -512,6 +557,7 @@ export class TasselCrowd {
     this._kind = kind;
     this._onError = options.onError ?? null;
     this._syncRotation = options.syncRotation ?? false;
+    this._worldMatrices = options.worldMatrices ?? true;
     const ptr = x.tassel_crowd_new(kind);
     if (!ptr) throw tassel.error('the crowd was not made');
     this._ptr = ptr;
@@ -525,7 +571,9 @@ export class TasselCrowd {
     this._written = indices(tassel, x.tassel_crowd_written_joint_count(ptr), (p, c) => x.tassel_crowd_written_joints(ptr, p, c), 'written joints');
     // The written joints' places in the output, parents first.
     const place = new Map(this._written.map((j, k) => [j, k]));
-    this._order = Int32Array.from(parentsFirst(this._written, depths), (j) => place.get(j));
+    this._order = Array.from(parentsFirst(this._written, depths), (j) => place.get(j));
+    // Where written joint k's transform is in a member's output.
+    this._writtenAt = Int32Array.from(this._written, (_, k) => k * FLOATS);
     // Each written joint's place among the read joints (-1: not read).
     const readAt = new Map(this._read.map((j, r) => [j, r]));
     this._writtenRead = Int32Array.from(this._written, (j) => readAt.get(j) ?? -1);
@@ -632,21 +680,17 @@ export class TasselCrowd {
     }
     // Made again if the frame grew the module's memory (which detaches the old views).
     const out = this._viewsNow()[2];
-    const order = this._order;
     const syncRotation = this._syncRotation;
+    const world = this._worldMatrices;
+    const writtenAt = this._writtenAt;
     for (let m = 0; m < count; m++) {
       const member = members[m];
       if (held[m] === 1) continue;
       member.lastError = null;
-      const parts = member._out;
       const wrote = member._wrote;
       const base = m * W;
-      for (let w = 0; w < order.length; w++) {
-        const k = order[w];
-        const at = k * FLOATS;
-        for (let i = 0; i < FLOATS; i++) wrote[at + i] = out[base + at + i];
-        if (parts.p[k] !== null) parts.write(k, out, base + at, syncRotation);
-      }
+      for (let i = 0; i < W; i++) wrote[i] = out[base + i];
+      writeBones(member._out, member._plan, out, base, writtenAt, syncRotation, world);
       member._hasWritten = true;
     }
     return code === 0;
@@ -697,6 +741,7 @@ export class TasselCrowdMember {
     this._objects = objects;
     this._in = new BoneParts(objects, crowd._read);
     this._out = new BoneParts(objects, crowd._written);
+    this._plan = writePlan(this._out, crowd._order, scene, crowd._worldMatrices);
     this._animated = new Float32Array(crowd._read.length * FLOATS);
     crowd._read.forEach((j, r) => this._animated.set(crowd._rest.subarray(j * FLOATS, (j + 1) * FLOATS), r * FLOATS));
     this._wrote = new Float32Array(crowd._written.length * FLOATS);
@@ -725,13 +770,15 @@ export class TasselCrowdMember {
   reset() {
     const crowd = this._crowd;
     if (!crowd) return;
+    // The written joints' animated pose (their rest pose for joints the solvers do not read).
     const wr = crowd._writtenRead;
+    const pose = new Float32Array(wr.length * FLOATS);
     for (let k = 0; k < wr.length; k++) {
-      if (this._out.p[k] === null) continue;
       const j = crowd._written[k];
-      const [src, at] = wr[k] >= 0 ? [this._animated, wr[k] * FLOATS] : [crowd._rest, j * FLOATS];
-      this._out.write(k, src, at, crowd._syncRotation);
+      pose.set(wr[k] >= 0 ? this._animated.subarray(wr[k] * FLOATS, (wr[k] + 1) * FLOATS) : crowd._rest.subarray(j * FLOATS, (j + 1) * FLOATS), k * FLOATS);
     }
+    this._scene.updateWorldMatrix(true, false);
+    writeBones(this._out, this._plan, pose, 0, crowd._writtenAt, crowd._syncRotation, crowd._worldMatrices);
     this._hasWritten = false;
     crowd._tassel.x.tassel_crowd_reset(crowd._ptr, this._index);
   }

@@ -112,6 +112,47 @@ async function compareCrowd(ctx, name, bytes, mode) {
   return { compared, ulps };
 }
 
+/** `worldMatrices: false` against the default: the same local transforms bit for bit every
+ *  frame (the simulation never reads matrixWorld), the written bones' matrixWorld left as
+ *  it was by update, and three.js's own scene.updateMatrixWorld() (what the renderer runs)
+ *  then gives what the default wrote (to float rounding: three.js multiplies the whole
+ *  4x4, the layer skips the local matrix's constant last row). */
+async function compareWorldMatrices(ctx, name, bytes) {
+  const { loadGltfBytes, TasselCrowd, check } = ctx;
+  const a = await loadGltfBytes(bytes);
+  const b = await loadGltfBytes(bytes);
+  const full = await TasselCrowd.fromBytes(bytes, { mode: 'three-vrm' });
+  const lean = await TasselCrowd.fromBytes(bytes, { mode: 'three-vrm', worldMatrices: false });
+  const ma = full.add(a.gltf), mb = lean.add(b.gltf);
+  const base = a.gltf.scene.position.clone();
+  let compared = 0;
+  let worst = 0;
+  for (let f = 1; f <= 40; f++) {
+    sway(a.gltf.scene, base, 0, f);
+    sway(b.gltf.scene, base, 0, f);
+    const before = mb.bones.map((o) => [...o.matrixWorld.elements]);
+    check(full.update(DT) && lean.update(DT), `${name}: worldMatrices: both crowds step`);
+    const ba = ma.bones, bb = mb.bones;
+    check(ba.length === bb.length && ba.length > 0, `${name}: worldMatrices: ${ba.length} and ${bb.length} bones`);
+    for (let k = 0; k < ba.length; k++) {
+      const qa = ba[k].quaternion, qb = bb[k].quaternion;
+      check(qa.equals(qb) && ba[k].matrix.elements.every((v, c) => v === bb[k].matrix.elements[c]),
+        `${name} frame ${f} bone ${ba[k].name}: worldMatrices: false changed the local transform`);
+      check(bb[k].matrixWorld.elements.every((v, c) => v === before[k][c]), `${name} frame ${f} bone ${bb[k].name}: worldMatrices: false wrote matrixWorld`);
+    }
+    b.gltf.scene.updateMatrixWorld(true);
+    for (let k = 0; k < ba.length; k++) {
+      const wa = ba[k].matrixWorld.elements, wb = bb[k].matrixWorld.elements;
+      for (let c = 0; c < 16; c++) worst = Math.max(worst, Math.abs(wa[c] - wb[c]));
+      compared++;
+    }
+  }
+  check(worst <= 1e-6, `${name}: worldMatrices: false then scene.updateMatrixWorld() is ${worst} from what update wrote`);
+  full.dispose();
+  lean.dispose();
+  return { compared, worst };
+}
+
 /** Every file (`{ name, bytes }`) in fixed and three-vrm mode. Returns the failures. */
 export async function runCrowdParity({ files, loadGltfBytes, TasselSpringBoneManager, TasselCrowd, log }) {
   let failures = 0;
@@ -122,6 +163,11 @@ export async function runCrowdParity({ files, loadGltfBytes, TasselSpringBoneMan
     }
   };
   const ctx = { loadGltfBytes, TasselSpringBoneManager, TasselCrowd, check };
+  if (files.length > 0) {
+    const { name, bytes } = files[0];
+    const { compared, worst } = await compareWorldMatrices(ctx, name, bytes);
+    log(`crowd ${name} worldMatrices: false: local transforms bit for bit, matrixWorld untouched; after scene.updateMatrixWorld() ${compared} bone-frames within ${worst.toExponential(1)} of update's`);
+  }
   for (const { name, bytes } of files) {
     for (const mode of ['fixed', 'three-vrm']) {
       const { compared, ulps } = await compareCrowd(ctx, name, bytes, mode);
