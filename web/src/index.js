@@ -312,6 +312,9 @@ class Driver {
     this.writtenAt = Int32Array.from(this.written, (j) => j * FLOATS);
     this.isWritten = new Uint8Array(n);
     for (const j of this.written) this.isWritten[j] = 1;
+    // The joints a frame depends on (for VRM springs: the springs, their ancestors and the
+    // colliders' nodes): update reads only these; the others keep their last value.
+    this.readJoints = Int32Array.from(indices(tassel, x.tassel_read_joint_count(ptr), (p, c) => x.tassel_read_joints(ptr, p, c), 'read joints'));
     // Transforms cross in one buffer of the module's memory: the root, then every joint.
     this.floats = n * FLOATS;
     this.buffer = tassel.copyIn(new Uint8Array((this.floats + FLOATS) * 4));
@@ -393,7 +396,9 @@ class Driver {
     this.scene.updateWorldMatrix(true, false);
     decompose(this.scene.matrixWorld, this.rootView, 0);
     const check = this.hasWritten;
-    for (let j = 0; j < this.count; j++) {
+    const readJoints = this.readJoints;
+    for (let r = 0; r < readJoints.length; r++) {
+      const j = readJoints[r];
       const at = j * FLOATS;
       if (!(check && isWritten[j] === 1 && all.holds(j, wrote, at))) all.read(j, a, at);
     }

@@ -153,6 +153,25 @@ int32_t tassel_simulated_joints(const TasselCharacter *c,
                                 size_t *out,
                                 size_t len);
 
+// How many joints a frame depends on (`tassel_read_joints`); 0 for NULL.
+//
+// # Safety
+// `c` is NULL or a live character.
+size_t tassel_read_joint_count(const TasselCharacter *c);
+
+// The joints whose animated transforms a frame depends on, ascending, into `out` (`len`
+// entries: exactly `tassel_read_joint_count`). The other joints' entries in
+// `tassel_frame`'s `locals_in` change nothing in the simulated joints: an engine may
+// leave them as they were and skip reading those bones. VRM spring bones without node
+// constraints read their springs, the springs' ancestors and the colliders' nodes;
+// other rigs every joint. 0 = ok, -1 = error.
+//
+// # Safety
+// `c` is NULL or a live character; `out` is NULL or points to `len` entries.
+int32_t tassel_read_joints(const TasselCharacter *c,
+                           size_t *out,
+                           size_t len);
+
 // The mode the character steps in ("fixed", "spec", "three-vrm" or "classic"),
 // borrowed: valid while the character lives. NULL for NULL.
 //

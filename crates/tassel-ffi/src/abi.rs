@@ -409,6 +409,39 @@ pub unsafe extern "C" fn tassel_simulated_joints(
     })
 }
 
+/// How many joints a frame depends on (`tassel_read_joints`); 0 for NULL.
+///
+/// # Safety
+/// `c` is NULL or a live character.
+#[no_mangle]
+pub unsafe extern "C" fn tassel_read_joint_count(c: *const TasselCharacter) -> usize {
+    guard("tassel_read_joint_count", 0, || {
+        // SAFETY: the caller's promise.
+        Ok(unsafe { character(c) }?.flat.read_joints().len())
+    })
+}
+
+/// The joints whose animated transforms a frame depends on, ascending, into `out` (`len`
+/// entries: exactly `tassel_read_joint_count`). The other joints' entries in
+/// `tassel_frame`'s `locals_in` change nothing in the simulated joints: an engine may
+/// leave them as they were and skip reading those bones. VRM spring bones without node
+/// constraints read their springs, the springs' ancestors and the colliders' nodes;
+/// other rigs every joint. 0 = ok, -1 = error.
+///
+/// # Safety
+/// `c` is NULL or a live character; `out` is NULL or points to `len` entries.
+#[no_mangle]
+pub unsafe extern "C" fn tassel_read_joints(
+    c: *const TasselCharacter,
+    out: *mut usize,
+    len: usize,
+) -> i32 {
+    guard("tassel_read_joints", -1, || {
+        // SAFETY: the caller's promises.
+        unsafe { copy_indices(character(c)?.flat.read_joints(), out, len, "read joints") }
+    })
+}
+
 /// `indices` into `out` (`len` entries, exactly as many).
 ///
 /// # Safety

@@ -3,6 +3,8 @@
 //! ([`crate::abi`]) and the WebAssembly module are thin shells over this one type.
 
 use std::path::Path;
+use std::sync::Arc;
+use tassel::crowd::{CrowdKind, VrmCrowd};
 use tassel::dynamics::vrm::VrmSpringBones;
 use tassel::dynamics::{RigSettings, SimMode};
 use tassel::glam::{Quat, Vec3};
@@ -48,9 +50,34 @@ pub struct FlatCharacter {
     joint_to_node: Vec<usize>,
     /// The nodes a solver writes, ascending.
     written: Vec<usize>,
+    /// The nodes whose animated transforms a frame depends on, ascending.
+    read: Vec<usize>,
     /// The animated pose of the frame being read, skeleton order (no allocation per
     /// frame).
     animated: Vec<Transform>,
+}
+
+/// The nodes `sim`'s frame reads (see [`FlatCharacter::read_joints`]), ascending: the
+/// VRM crowd's input joints where the character could run on that crowd (the same plan
+/// of the same springs), else every node.
+fn read_nodes(sim: &CharacterSim, joint_to_node: &[usize]) -> Vec<usize> {
+    let rig = sim.rig();
+    let every = || (0..joint_to_node.len()).collect::<Vec<usize>>();
+    let joints = match CrowdKind::of(rig) {
+        Some(CrowdKind::Vrm) => {
+            match VrmCrowd::new(
+                Arc::new(rig.skeleton().clone()),
+                Arc::new(rig.vrm().clone()),
+            ) {
+                Ok(crowd) => crowd.input_joints().to_vec(),
+                Err(_) => return every(),
+            }
+        }
+        _ => return every(),
+    };
+    let mut nodes: Vec<usize> = joints.iter().map(|&j| joint_to_node[j]).collect();
+    nodes.sort_unstable();
+    nodes
 }
 
 /// `"fixed"`, `"spec"`, `"three-vrm"` or `"classic"` (as `tassel simulate --mode`).
@@ -133,12 +160,14 @@ impl FlatCharacter {
             .map(|&j| joint_to_node[j])
             .collect();
         written.sort_unstable();
+        let read = read_nodes(&sim, &joint_to_node);
         Ok(Self {
             sim,
             mode,
             node_to_joint: model.node_to_joint,
             joint_to_node,
             written,
+            read,
             animated: rest,
         })
     }
@@ -165,6 +194,15 @@ impl FlatCharacter {
     /// its input.
     pub fn simulated_joints(&self) -> &[usize] {
         &self.written
+    }
+
+    /// The joints (node indices, ascending) whose animated transforms a frame depends on:
+    /// the others' inputs change nothing in the simulated joints (a caller may leave them
+    /// as they were, and skip reading them from its scene). For VRM spring bones without
+    /// node constraints, the joints their update reads (the springs, their ancestors and
+    /// the colliders' nodes, as the crowd reads them); otherwise every joint.
+    pub fn read_joints(&self) -> &[usize] {
+        &self.read
     }
 
     /// The mode the character steps in.
