@@ -55,15 +55,7 @@ fn input(kind: &FlatCharacter, read: &[usize], i: usize, f: usize) -> ([f32; F],
     kind.rest_locals(&mut locals).unwrap();
     // Turn the first two read joints (a hips and a head, say) about x.
     for (k, &j) in read.iter().take(2).enumerate() {
-        let a = 0.3 * (4.0 * t + phase + k as f32).sin();
-        let q = tassel::glam::Quat::from_rotation_x(a)
-            * tassel::glam::Quat::from_xyzw(
-                locals[j * F + 3],
-                locals[j * F + 4],
-                locals[j * F + 5],
-                locals[j * F + 6],
-            );
-        locals[j * F + 3..j * F + 7].copy_from_slice(&q.normalize().to_array());
+        common::turn_about_x(&mut locals, j, 0.3 * (4.0 * t + phase + k as f32).sin());
     }
     (root, locals)
 }

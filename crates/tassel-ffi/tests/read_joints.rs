@@ -32,14 +32,7 @@ fn input(c: &FlatCharacter, f: usize) -> ([f32; F], Vec<f32>) {
     let mut locals = vec![0.0; c.joint_count() * F];
     c.rest_locals(&mut locals).unwrap();
     for (k, &j) in c.read_joints().iter().take(2).enumerate() {
-        let q = Quat::from_rotation_x(0.3 * (4.0 * t + k as f32).sin())
-            * Quat::from_xyzw(
-                locals[j * F + 3],
-                locals[j * F + 4],
-                locals[j * F + 5],
-                locals[j * F + 6],
-            );
-        locals[j * F + 3..j * F + 7].copy_from_slice(&q.normalize().to_array());
+        common::turn_about_x(&mut locals, j, 0.3 * (4.0 * t + k as f32).sin());
     }
     (root, locals)
 }

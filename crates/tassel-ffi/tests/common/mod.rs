@@ -36,3 +36,13 @@ pub fn builtin_glb() -> Vec<u8> {
     let source = tassel_gltf::ExportSource::from_skeleton(&c.skeleton, tassel_gltf::BoneMesh::None);
     tassel_gltf::export_glb(&source, &[]).unwrap()
 }
+
+/// Turns joint `j`'s local rotation in `locals` (10 floats a joint) by `angle` about x
+/// (applied after it), normalised.
+pub fn turn_about_x(locals: &mut [f32], j: usize, angle: f32) {
+    let f = tassel_ffi::FLOATS_PER_JOINT;
+    let r = &mut locals[j * f + 3..j * f + 7];
+    let q = tassel::glam::Quat::from_rotation_x(angle)
+        * tassel::glam::Quat::from_xyzw(r[0], r[1], r[2], r[3]);
+    r.copy_from_slice(&q.normalize().to_array());
+}
