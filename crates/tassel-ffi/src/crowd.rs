@@ -92,24 +92,19 @@ impl FlatCrowd {
         let sim = kind.sim();
         let rig = sim.rig().clone();
         let sk = Arc::new(rig.skeleton().clone());
-        let n = sk.len();
         let built = match CrowdKind::of(&rig) {
             Some(CrowdKind::Vrm) => VrmCrowd::new(sk.clone(), Arc::new(rig.vrm().clone()))
                 .ok()
-                .map(|c| {
-                    let read = c.input_joints().to_vec();
-                    (Run::Vrm(c), read)
-                }),
+                .map(Run::Vrm),
             Some(CrowdKind::Chains) => ChainCrowd::new(sk.clone(), Arc::new(rig.chains().clone()))
                 .ok()
-                .map(|c| (Run::Chains(c), (0..n).collect())),
+                .map(Run::Chains),
             None => None,
         };
-        let (run, read_joint) =
-            built.unwrap_or_else(|| (Run::Characters(Vec::new()), (0..n).collect()));
-        let node_of = |j: &usize| kind.node_of(*j).unwrap_or(*j);
-        let mut read: Vec<usize> = read_joint.iter().map(node_of).collect();
-        read.sort_unstable();
+        let run = built.unwrap_or_else(|| Run::Characters(Vec::new()));
+        // What a frame reads: the character's own list (for VRM springs the VRM crowd's
+        // input joints, made the same way as this crowd's; else every joint).
+        let read = kind.read_joints().to_vec();
         let written = kind.simulated_joints().to_vec();
         let joint_of = |nodes: &[usize]| -> Vec<usize> {
             nodes.iter().map(|&node| kind.joint_of(node)).collect()
