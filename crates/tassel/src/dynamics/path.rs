@@ -76,6 +76,10 @@ impl CharacterPath {
     /// frame before, 1 = the newest.
     pub fn at(&self, w: f32) -> Transform {
         let (a, b) = (self.frames[2], self.frames[3]);
+        if w >= 1.0 {
+            // The newest frame itself (a step that ends on the frame): no history read.
+            return b;
+        }
         let linear = || {
             Transform::from_translation_rotation(
                 a.translation.lerp(b.translation, w),
@@ -159,6 +163,69 @@ impl CharacterPath {
     }
 }
 
+/// Time left over after a frame's fixed steps, as a share of a step, below which it is
+/// dropped: the last step then ends on the frame (the same tolerance the step count
+/// takes the other way, where a frame short of a step by this much still takes it).
+pub(crate) const ON_FRAME: f32 = 1e-4;
+
+/// A fixed-step solver's clock for one frame: how many steps of `h` it takes, where each
+/// ends, and the time left over for the next frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct FixedClock {
+    /// Steps this frame.
+    pub steps: u32,
+    /// Seconds left over after them (0 when the last step ends on the frame).
+    pub left: f32,
+    acc_old: f32,
+    skipped: f32,
+    dt: f32,
+    h: f32,
+}
+
+impl FixedClock {
+    /// The steps of a frame of `dt` after `acc_old` seconds left over, at most `max_steps`
+    /// (a hitch drops the time it cannot afford and keeps the most recent steps).
+    pub fn new(acc_old: f32, dt: f32, h: f32, max_steps: u32) -> Self {
+        let mut total = acc_old + dt;
+        let mut steps = (total / h + ON_FRAME).floor() as u32;
+        if steps > max_steps {
+            total -= (steps - max_steps) as f32 * h;
+            steps = max_steps;
+        }
+        let mut left = (total - steps as f32 * h).max(0.0);
+        if steps > 0 && left < ON_FRAME * h {
+            left = 0.0;
+        }
+        Self {
+            steps,
+            left,
+            acc_old,
+            skipped: acc_old + dt - total,
+            dt,
+            h,
+        }
+    }
+
+    /// Where step `k` (1..=steps) ends between last frame (0) and this frame (1): exactly
+    /// 1 for the last step when nothing is left over.
+    pub fn end(&self, k: u32) -> f32 {
+        if k == self.steps && self.left == 0.0 {
+            return 1.0;
+        }
+        let end = k as f32 * self.h - self.acc_old + self.skipped;
+        if self.dt > 0.0 {
+            (end / self.dt).clamp(0.0, 1.0)
+        } else {
+            1.0
+        }
+    }
+
+    /// Whether the last step ends on the frame (then nothing is left over).
+    pub fn on_frame(&self) -> bool {
+        self.steps > 0 && self.left == 0.0
+    }
+}
+
 /// The rotation vector (axis · angle, angle in [0, π]) of `q`, on the shortest way.
 fn rotation_vector(q: Quat) -> Vec3 {
     let q = if q.w < 0.0 { -q } else { q };
@@ -239,5 +306,45 @@ mod tests {
         path.push(sway(3.0 * h + 0.5), 0.5);
         let mid = path.at(0.5).translation;
         assert!((mid - line(sway(3.0 * h), sway(3.0 * h + 0.5), 0.5)).length() < 1e-5);
+    }
+
+    /// Whole steps end on the frame (60 Hz frames of 60 Hz steps, 30 Hz frames of two),
+    /// with a last share of exactly 1; 144 Hz frames carry time over; a hitch keeps the
+    /// most recent steps; the time is all accounted for.
+    #[test]
+    fn fixed_clock_counts_steps_and_time() {
+        let h = 1.0 / 60.0;
+        let c = FixedClock::new(0.0, 1.0 / 60.0, h, 8);
+        assert_eq!((c.steps, c.left, c.end(1)), (1, 0.0, 1.0));
+        assert!(c.on_frame());
+        let c = FixedClock::new(0.0, 1.0 / 30.0, h, 8);
+        assert_eq!((c.steps, c.left), (2, 0.0));
+        assert!((c.end(1) - 0.5).abs() < 1e-6 && c.end(2) == 1.0);
+        // A frame a hair longer or shorter than a step still ends on it.
+        for dt in [h * (1.0 - 5e-5), h * (1.0 + 5e-5)] {
+            let c = FixedClock::new(0.0, dt, h, 8);
+            assert_eq!((c.steps, c.left), (1, 0.0), "dt = {dt}");
+        }
+        // 144 Hz: 0, 1, 0 steps... with the remainder carried.
+        let (mut acc, mut steps) = (0.0f32, 0);
+        for _ in 0..144 {
+            let c = FixedClock::new(acc, 1.0 / 144.0, h, 8);
+            assert!(c.left < h && c.left >= 0.0);
+            if c.steps > 0 {
+                assert!(c.end(1) > 0.0 && c.end(1) <= 1.0);
+            }
+            steps += c.steps;
+            acc = c.left;
+        }
+        assert_eq!(steps, 60, "one second of 144 Hz frames is 60 steps");
+        // A hitch of 1 s at most 8 steps: the last 8, ending on the frame.
+        let c = FixedClock::new(0.0, 1.0, h, 8);
+        assert_eq!(c.steps, 8);
+        assert_eq!(c.end(8), 1.0);
+        assert!((c.end(1) - (1.0 - 7.0 * h)).abs() < 1e-5);
+        // No step: nothing dropped.
+        let c = FixedClock::new(0.0, 1e-7, h, 8);
+        assert_eq!((c.steps, c.left), (0, 1e-7));
+        assert!(!c.on_frame());
     }
 }

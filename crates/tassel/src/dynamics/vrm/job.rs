@@ -5,11 +5,11 @@ use super::collide::PlacedVrmCollider;
 use super::compile::{VrmLink, VrmRig};
 use super::lanes::contact::Placed;
 use super::settings::VrmMode;
-use crate::dynamics::path::CharacterPath;
+use crate::dynamics::path::{CharacterPath, FixedClock};
 use crate::dynamics::vrm::lanes::springs::{SpringIo, SpringLanes};
 use crate::error::{Error, Result};
 use crate::lanes::{Isa, SimdUse};
-use crate::math::{normalize_or, rotation_arc, slerp_shortest, Transform};
+use crate::math::{extrapolate_rotation, normalize_or, rotation_arc, Transform};
 use crate::skeleton::Skeleton;
 use glam::{Quat, Vec3};
 
@@ -25,7 +25,10 @@ pub struct VrmState {
     /// three-vrm mode: each link's tail node (world) at the end of the previous frame.
     stale_tail: Vec<Vec3>,
     rotation: Vec<Quat>,
+    /// Fixed mode: the rotations one and two steps before `rotation` (the output between
+    /// steps is the quadratic through the three).
     rotation_before: Vec<Quat>,
+    rotation_older: Vec<Quat>,
     placed: Vec<PlacedVrmCollider>,
     // Fixed mode: last frame's animated input and the scratch pose of a step.
     prev_locals: Vec<Transform>,
@@ -57,6 +60,7 @@ impl VrmState {
             stale_tail: vec![Vec3::ZERO; l],
             rotation: vec![Quat::IDENTITY; l],
             rotation_before: vec![Quat::IDENTITY; l],
+            rotation_older: vec![Quat::IDENTITY; l],
             placed: vec![none; rig.colliders.len()],
             prev_locals: vec![Transform::IDENTITY; n],
             step_locals: vec![Transform::IDENTITY; n],
@@ -101,6 +105,7 @@ impl VrmState {
             stale_tail: &self.stale_tail,
             rotation: &mut self.rotation,
             rotation_before: &self.rotation_before,
+            rotation_older: &self.rotation_older,
         }
     }
 
@@ -278,6 +283,9 @@ impl VrmJob<'_> {
         // Whether `models` is still the model pose of the animated `locals` given (no
         // reset wrote it with the lazy refresh's root rule).
         let mut models_given = rig.constraints.list.is_empty();
+        // Fixed mode: whether this frame's last step ended on the frame, on its pose and
+        // colliders (then its rotations are the output, pushed out already).
+        let mut on_frame = false;
         if state.needs_reset {
             reset(skeleton, rig, state, &component, locals, models);
             models_given = false;
@@ -292,7 +300,9 @@ impl VrmJob<'_> {
                     }
                     state.rotation_before.copy_from_slice(&state.rotation);
                 }
-                VrmMode::Fixed => run_fixed(skeleton, rig, state, dt, locals),
+                VrmMode::Fixed => {
+                    on_frame = run_fixed(skeleton, rig, state, dt, locals, models, models_given)
+                }
             }
         }
         // Guard: never let a non-finite value out; start again from the pose instead.
@@ -302,30 +312,45 @@ impl VrmJob<'_> {
             reset(skeleton, rig, state, &component, locals, models);
             lanes_ran = false;
             models_given = false;
+            on_frame = false;
+        }
+        // A last step on this frame's own pose in lanes wrote the output's models of the
+        // links (the joints below them are left to `refresh_below`, as in the spec
+        // modes). The scalar step's models are its lazy refresh's, which takes a root
+        // link's local as its model: the whole pose is composed again below.
+        if on_frame && lane_plan(rig, state).is_some() {
+            models.copy_from_slice(&state.step_models);
+            lanes_ran = true;
         }
         state.prev_locals.copy_from_slice(locals);
         state.prev_component = component;
-        // Output: the last rotations (fixed mode: between the last two steps).
-        let w = match opts.mode {
-            VrmMode::Spec | VrmMode::ThreeVrm => 1.0,
-            VrmMode::Fixed => (state.accumulator * opts.step_rate).clamp(0.0, 1.0),
+        // Output: the last rotations; in fixed mode the newest step's carried `a` of a
+        // step on (the time not yet stepped) along the quadratic through the last three.
+        let fixed = opts.mode == VrmMode::Fixed;
+        let a = if fixed {
+            (state.accumulator * opts.step_rate).clamp(0.0, 1.0)
+        } else {
+            0.0
         };
-        if opts.mode == VrmMode::Fixed {
+        // Fixed mode's output pass: unless the last step ended on this frame, the output
+        // is pushed out of this frame's colliders (and limited).
+        let output_pass = fixed && !on_frame;
+        if output_pass {
             // This frame's colliders, from the animated pose.
             place_colliders(rig, state, &component, models);
         }
         // Fixed mode's output pass in lanes: it turns the links to their output rotations
         // (the same slerps, eight at a time) and composes every link's model from its
         // parent's, then the joints below the links.
-        let lane_output = opts.mode == VrmMode::Fixed
-            && !rig.link_colliders.is_empty()
-            && lane_plan(rig, state).is_some();
+        let lane_output =
+            output_pass && !rig.link_colliders.is_empty() && lane_plan(rig, state).is_some();
         for (i, l) in rig.links.iter().enumerate().filter(|_| !lane_output) {
-            locals[l.joint].rotation = if w >= 1.0 {
-                state.rotation[i]
-            } else {
-                slerp_shortest(state.rotation_before[i], state.rotation[i], w)
-            };
+            locals[l.joint].rotation = extrapolate_rotation(
+                state.rotation_older[i],
+                state.rotation_before[i],
+                state.rotation[i],
+                a,
+            );
         }
         match (&rig.lanes, lanes_ran && rig.constraints.list.is_empty()) {
             // The links' models are those of their new rotations already (the lane path
@@ -336,11 +361,10 @@ impl VrmJob<'_> {
             (Some(_), false) if lane_output && models_given => {}
             _ => crate::pose::local_to_model_into(skeleton, locals, models),
         }
-        if opts.mode == VrmMode::Fixed && (!rig.link_colliders.is_empty() || rig.has_limits()) {
-            // The interpolated pose lags a step and may cut through a collider between
-            // two steps (or leave a limit): it is pushed out by this frame's colliders
-            // (and limited) like a step's tail.
-            collide_output(skeleton, rig, state, &component, w, locals, models);
+        if output_pass && (!rig.link_colliders.is_empty() || rig.has_limits()) {
+            // The pose carried past the last step was collided at no step: it is pushed
+            // out by this frame's colliders (and limited) like a step's tail.
+            collide_output(skeleton, rig, state, &component, a, locals, models);
         }
         if opts.mode == VrmMode::ThreeVrm {
             // Where each tail node ends this frame: next frame's bone length measures to it.
@@ -355,25 +379,26 @@ fn lane_plan<'a>(rig: &'a VrmRig, state: &VrmState) -> Option<&'a SpringLanes> {
     rig.lanes.as_ref().filter(|_| state.simd != SimdUse::Scalar)
 }
 
-/// Fixed-mode output pass: each link's tail (from the interpolated pose) pushed out of this
+/// Fixed-mode output pass: each link's tail (from the output pose) pushed out of this
 /// frame's colliders with the spec's push and length projection, the rotation rewritten.
-/// The lane path also writes the links' output rotations (`w` of the way between the last
-/// two steps' rotations) first; the scalar path finds them written by the caller.
+/// The lane path also writes the links' output rotations (the newest step's carried `a`
+/// of a step on, [`extrapolate_rotation`]) first; the scalar path finds them written by
+/// the caller.
 fn collide_output(
     sk: &Skeleton,
     rig: &VrmRig,
     state: &mut VrmState,
     component: &Transform,
-    w: f32,
+    a: f32,
     locals: &mut [Transform],
     models: &mut [Transform],
 ) {
     if let Some(lanes) = lane_plan(rig, state) {
         // The same results, several springs at a time (`dynamics/vrm/lanes/springs.rs`), which
-        // also turn the links to their output rotations (`w`).
+        // also turn the links to their output rotations (`a`).
         let isa = Isa::of(state.simd);
         let mut io = state.lane_io(component, 0.0, VrmMode::Fixed, locals, models);
-        lanes.collide_output(sk, rig, &mut io, w, isa);
+        lanes.collide_output(sk, rig, &mut io, a, isa);
         return;
     }
     let mut stale_from = sk.len();
@@ -443,6 +468,7 @@ fn reset(
         state.prev_tail[i] = stored;
         state.rotation[i] = l.rest_local.rotation;
         state.rotation_before[i] = l.rest_local.rotation;
+        state.rotation_older[i] = l.rest_local.rotation;
     }
     record_tails(rig, state, component, models);
     state.accumulator = 0.0;
@@ -681,49 +707,55 @@ fn refresh(sk: &Skeleton, locals: &[Transform], models: &mut [Transform], from: 
 }
 
 /// Fixed mode: whole steps of `1/step_rate` up to now, each with the animated pose and the
-/// character transform interpolated to its time; remembers the last two step rotations.
-fn run_fixed(sk: &Skeleton, rig: &VrmRig, state: &mut VrmState, dt: f32, locals: &[Transform]) {
+/// character transform interpolated to its time; remembers the last three step rotations.
+/// Time left over within [`ON_FRAME`](crate::dynamics::path::ON_FRAME) of a step is dropped, and a last step that then ends
+/// on the frame takes the frame's own pose (`locals`, and `models` when `models_given`
+/// says it is their model pose): returns whether it did, so that its rotations are the
+/// frame's output as they are.
+fn run_fixed(
+    sk: &Skeleton,
+    rig: &VrmRig,
+    state: &mut VrmState,
+    dt: f32,
+    locals: &[Transform],
+    models: &[Transform],
+    models_given: bool,
+) -> bool {
     let opts = &rig.options;
     let h = 1.0 / opts.step_rate;
-    let acc_old = state.accumulator;
-    let mut total = acc_old + dt;
-    let mut steps = (total / h + 1e-4).floor() as u32;
-    if steps > opts.max_steps_per_frame {
-        // A hitch: drop the time we cannot afford, keep the most recent steps.
-        total -= (steps - opts.max_steps_per_frame) as f32 * h;
-        steps = opts.max_steps_per_frame;
-    }
-    let skipped = acc_old + dt - total;
-    for k in 1..=steps {
-        // Where this step ends between last frame (0) and this frame (1).
-        let end = k as f32 * h - acc_old + skipped;
-        let w = if dt > 0.0 {
-            (end / dt).clamp(0.0, 1.0)
-        } else {
-            1.0
-        };
+    let clock = FixedClock::new(state.accumulator, dt, h, opts.max_steps_per_frame);
+    for k in 1..=clock.steps {
+        let w = clock.end(k);
         let comp = state.path.at(w);
         let mut step_locals = std::mem::take(&mut state.step_locals);
         let mut step_models = std::mem::take(&mut state.step_models);
-        match lane_plan(rig, state) {
-            Some(lanes) => {
-                // Only what the lane update and the colliders read of the step's pose (the
-                // same values where they read it).
-                let isa = Isa::of(state.simd);
-                let frames = (&state.prev_locals[..], locals);
-                lanes.step_pose(sk, frames, w, &mut step_locals, &mut step_models, isa);
-            }
-            None => {
-                for (s, (a, b)) in step_locals
-                    .iter_mut()
-                    .zip(state.prev_locals.iter().zip(locals))
-                {
-                    *s = a.lerp(b, w);
+        if w >= 1.0 && models_given {
+            // The frame's own pose, as given (the same values as the lerp's and the
+            // refresh's would be only nearly).
+            step_locals.copy_from_slice(locals);
+            step_models.copy_from_slice(models);
+        } else {
+            match lane_plan(rig, state) {
+                Some(lanes) => {
+                    // Only what the lane update and the colliders read of the step's pose
+                    // (the same values where they read it).
+                    let isa = Isa::of(state.simd);
+                    let frames = (&state.prev_locals[..], locals);
+                    lanes.step_pose(sk, frames, w, &mut step_locals, &mut step_models, isa);
                 }
-                refresh(sk, &step_locals, &mut step_models, 0, sk.len() - 1);
+                None => {
+                    for (s, (a, b)) in step_locals
+                        .iter_mut()
+                        .zip(state.prev_locals.iter().zip(locals))
+                    {
+                        *s = if w >= 1.0 { *b } else { a.lerp(b, w) };
+                    }
+                    refresh(sk, &step_locals, &mut step_models, 0, sk.len() - 1);
+                }
             }
         }
         place_colliders(rig, state, &comp, &step_models);
+        state.rotation_older.copy_from_slice(&state.rotation_before);
         state.rotation_before.copy_from_slice(&state.rotation);
         update(
             sk,
@@ -738,5 +770,6 @@ fn run_fixed(sk: &Skeleton, rig: &VrmRig, state: &mut VrmState, dt: f32, locals:
         state.step_locals = step_locals;
         state.step_models = step_models;
     }
-    state.accumulator = (total - steps as f32 * h).max(0.0);
+    state.accumulator = clock.left;
+    clock.on_frame() && models_given
 }

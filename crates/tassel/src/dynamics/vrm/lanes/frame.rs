@@ -7,6 +7,7 @@
 
 use super::contact::{collide_tail, limit_lanes, Placed};
 use super::pack::{LinkPlan, Pack, Plan, Scratch};
+use crate::dynamics::path::FixedClock;
 use crate::dynamics::vrm::{VrmMode, VrmRig, VrmShape};
 use crate::error::Error;
 #[cfg(target_arch = "x86_64")]
@@ -325,17 +326,21 @@ impl Ctx<'_> {
             reset = reset.or(moved.gt(F::splat(opts.teleport_distance)));
         }
         // The animated model pose (as the single-character frame computes it); where the
-        // specification's update runs, only of the slots it reads before writing them.
-        let updates = !fixed && self.dt > 0.0 && reset != M::ALL;
+        // specification's update runs (fixed mode: on every frame), only of the slots it
+        // reads before writing them: fixed mode's output pose and pass also compose the
+        // slots the springs move before reading them.
+        let updates = (fixed || self.dt > 0.0) && reset != M::ALL;
         for k in 0..plan.joints.len() {
             if updates && !plan.read_animated[k] {
                 continue;
             }
             s.models[k] = under::<T>(&s.models, plan.parent[k], &s.locals[k]).f();
         }
+        // Fixed mode: the lanes whose last step ended on this frame.
+        let mut on_frame = M::NONE;
         if reset != M::ALL {
             if fixed {
-                self.run_fixed::<T>(pack, s, reset);
+                on_frame = self.run_fixed::<T>(pack, s, reset);
             } else if self.dt > 0.0 {
                 let Scratch {
                     locals,
@@ -360,6 +365,7 @@ impl Ctx<'_> {
             bad = bad.or(tail.finite().and(rotation.finite()).not());
         }
         let again = reset.or(bad.m());
+        let on_frame = on_frame.and(again.not());
         if again.any() {
             let still_bad = self.reset(pack, s, again);
             for lane in 0..LANES {
@@ -374,7 +380,7 @@ impl Ctx<'_> {
             }
         }
         if fixed {
-            self.fixed_output(pack, s, again);
+            self.fixed_output(pack, s, again, on_frame);
         } else {
             pack.out_rotation.copy_from_slice(&pack.rotation);
         }
@@ -593,63 +599,81 @@ impl Ctx<'_> {
     }
 
     /// Fixed mode: whole steps of `1/step_rate` up to now for the lanes not reset, each
-    /// with the animated pose and the character transform interpolated to its time.
+    /// with the animated pose and the character transform interpolated to its time (a
+    /// last step that ends on the frame on the frame's own pose). Returns the lanes whose
+    /// last step ended on the frame, when the rig has no node constraints (the scalar
+    /// job's `on_frame`).
     #[inline(always)]
-    pub(crate) fn run_fixed<T: Lane>(&self, pack: &mut Pack, s: &mut Scratch, reset: M) {
+    pub(crate) fn run_fixed<T: Lane>(&self, pack: &mut Pack, s: &mut Scratch, reset: M) -> M {
         let opts = &self.rig.options;
         let h = 1.0 / opts.step_rate;
         let dt = self.dt;
-        let mut steps = [0u32; LANES];
-        let mut acc_old = [0.0f32; LANES];
-        let mut skipped = [0.0f32; LANES];
+        let mut clocks = [None; LANES];
         let mut most = 0;
         for lane in 0..LANES {
             if reset.get(lane) {
                 continue;
             }
-            let old = pack.accumulator[lane];
-            let mut total = old + dt;
-            let mut n = (total / h + 1e-4).floor() as u32;
-            if n > opts.max_steps_per_frame {
-                // A hitch: drop the time we cannot afford, keep the most recent steps.
-                total -= (n - opts.max_steps_per_frame) as f32 * h;
-                n = opts.max_steps_per_frame;
-            }
-            steps[lane] = n;
-            acc_old[lane] = old;
-            skipped[lane] = old + dt - total;
-            pack.accumulator[lane] = (total - n as f32 * h).max(0.0);
-            most = most.max(n);
+            let clock = FixedClock::new(pack.accumulator[lane], dt, h, opts.max_steps_per_frame);
+            pack.accumulator[lane] = clock.left;
+            most = most.max(clock.steps);
+            clocks[lane] = Some(clock);
         }
         let Scratch {
             locals,
+            models,
             step_locals,
             step_models,
             placed,
             ..
         } = s;
         for k in 1..=most {
-            let active = M::from_bools(std::array::from_fn(|l| !reset.get(l) && k <= steps[l]));
+            let active = M::from_bools(std::array::from_fn(|l| {
+                clocks[l].is_some_and(|c| k <= c.steps)
+            }));
             let mut w = [1.0f32; LANES];
             let mut comp = Trs::<F>::splat(&Transform::IDENTITY);
             for lane in 0..LANES {
                 // Where this step ends between last frame (0) and this frame (1).
-                let end = k as f32 * h - acc_old[lane] + skipped[lane];
-                if dt > 0.0 {
-                    w[lane] = (end / dt).clamp(0.0, 1.0);
+                if let Some(c) = clocks[lane].filter(|c| k <= c.steps) {
+                    w[lane] = c.end(k);
                 }
                 comp.set(lane, &pack.paths[lane].at(w[lane]));
             }
-            let w = F(w);
-            for slot in 0..self.plan.joints.len() {
-                step_locals[slot] = pack.prev_locals[slot].lerp(&locals[slot], w);
-                // The scalar step refreshes every joint, a root as its local.
-                step_models[slot] = match self.plan.parent[slot] {
-                    Some(p) => Trs::<T>::of(&step_models[p])
-                        .mul(&Trs::of(&step_locals[slot]))
-                        .f(),
-                    None => step_locals[slot],
+            let frame_pose = w.iter().all(|&w| w >= 1.0);
+            if frame_pose && active == M::ALL && self.rig.constraints.list.is_empty() {
+                // Every lane's last step ends on the frame (and none will need the output
+                // pass, whose colliders are placed from the animated models): it steps on
+                // the frame's pose itself.
+                let mut poses = Poses {
+                    comp: Trs::<T>::of(&comp),
+                    locals,
+                    models,
                 };
+                self.place_colliders(&poses, placed);
+                self.shift_rotations(pack, active);
+                let active = <T::M as Mask>::of(active);
+                self.update(pack, &mut poses, placed, VrmMode::Fixed, active);
+                continue;
+            }
+            if frame_pose {
+                // Some lanes' step ends on the frame: its pose is the frame's.
+                step_locals.copy_from_slice(locals);
+                step_models.copy_from_slice(models);
+            } else {
+                let w = F(w);
+                let whole = F::splat(1.0).le(w);
+                for slot in 0..self.plan.joints.len() {
+                    let between = pack.prev_locals[slot].lerp(&locals[slot], w);
+                    step_locals[slot] = Trs::select(whole, &locals[slot], &between);
+                    // The scalar step refreshes every joint, a root as its local.
+                    step_models[slot] = match self.plan.parent[slot] {
+                        Some(p) => Trs::<T>::of(&step_models[p])
+                            .mul(&Trs::of(&step_locals[slot]))
+                            .f(),
+                        None => step_locals[slot],
+                    };
+                }
             }
             let mut poses = Poses {
                 comp: Trs::<T>::of(&comp),
@@ -657,19 +681,40 @@ impl Ctx<'_> {
                 models: step_models,
             };
             self.place_colliders(&poses, placed);
-            for i in 0..pack.rotation.len() {
-                pack.rotation_before[i] =
-                    Q::select(active, pack.rotation[i], pack.rotation_before[i]);
-            }
+            self.shift_rotations(pack, active);
             let active = <T::M as Mask>::of(active);
             self.update(pack, &mut poses, placed, VrmMode::Fixed, active);
         }
+        if !self.rig.constraints.list.is_empty() {
+            return M::NONE;
+        }
+        M::from_bools(std::array::from_fn(|l| {
+            clocks[l].is_some_and(|c| c.on_frame())
+        }))
     }
 
-    /// Fixed mode's output: the rotations between the last two steps, pushed out of this
-    /// frame's colliders; and this frame's pose kept for the next frame's steps.
+    /// Fixed mode, before a step of the lanes in `active`: each rotation becomes the one a
+    /// step before, that one the one two steps before.
     #[inline(always)]
-    pub(crate) fn fixed_output(&self, pack: &mut Pack, s: &mut Scratch, reset: M) {
+    fn shift_rotations(&self, pack: &mut Pack, active: M) {
+        if active == M::ALL {
+            std::mem::swap(&mut pack.rotation_older, &mut pack.rotation_before);
+            pack.rotation_before.copy_from_slice(&pack.rotation);
+            return;
+        }
+        for i in 0..pack.rotation.len() {
+            pack.rotation_older[i] =
+                Q::select(active, pack.rotation_before[i], pack.rotation_older[i]);
+            pack.rotation_before[i] = Q::select(active, pack.rotation[i], pack.rotation_before[i]);
+        }
+    }
+
+    /// Fixed mode's output: the last step's rotations carried past it by the time not yet
+    /// stepped, pushed out of this frame's colliders (but in the lanes `on_frame`, whose
+    /// last step ended on this frame and was pushed out of them); and this frame's pose
+    /// kept for the next frame's steps.
+    #[inline(always)]
+    pub(crate) fn fixed_output(&self, pack: &mut Pack, s: &mut Scratch, reset: M, on_frame: M) {
         let plan = self.plan;
         let opts = &self.rig.options;
         // Last frame's pose for the next steps: the animated locals, with the rest
@@ -681,12 +726,16 @@ impl Ctx<'_> {
             }
             pack.prev_locals[slot] = kept;
         }
-        // This frame's colliders: from the animated pose (the reset's pose where reset).
-        for slot in 0..plan.joints.len() {
-            s.step_models[slot] = Trs::select(reset, &s.reset_models[slot], &s.models[slot]);
-        }
+        let pass = on_frame.not();
+        let output_pass =
+            pass != M::NONE && (!self.rig.link_colliders.is_empty() || self.rig.has_limits());
         let comp = s.component;
-        {
+        if output_pass {
+            // This frame's colliders: from the animated pose (the reset's pose where
+            // reset), before the output pose is written over it.
+            for slot in 0..plan.joints.len() {
+                s.step_models[slot] = Trs::select(reset, &s.reset_models[slot], &s.models[slot]);
+            }
             let poses = Poses {
                 comp,
                 locals: &s.locals,
@@ -694,21 +743,28 @@ impl Ctx<'_> {
             };
             self.place_colliders(&poses, &mut s.placed);
         }
-        let mut w = [0.0f32; LANES];
+        let mut a = [0.0f32; LANES];
         for lane in 0..LANES {
-            w[lane] = (pack.accumulator[lane] * opts.step_rate).clamp(0.0, 1.0);
+            a[lane] = (pack.accumulator[lane] * opts.step_rate).clamp(0.0, 1.0);
         }
-        let w = F(w);
-        let full = F::splat(1.0).le(w);
-        for i in 0..pack.rotation.len() {
-            let between = pack.rotation_before[i].slerp_shortest(pack.rotation[i], w);
-            pack.out_rotation[i] = Q::select(full, pack.rotation[i], between);
+        let a = F(a);
+        if a.le(F::splat(0.0)) == M::ALL {
+            pack.out_rotation.copy_from_slice(&pack.rotation);
+        } else {
+            for i in 0..pack.rotation.len() {
+                pack.out_rotation[i] = pack.rotation[i].extrapolate(
+                    pack.rotation_older[i],
+                    pack.rotation_before[i],
+                    a,
+                );
+            }
         }
-        self.output_pose(pack, s);
-        if self.rig.link_colliders.is_empty() && !self.rig.has_limits() {
+        if !output_pass {
+            // The crowd's output is the rotations (`write_pose` composes the pose).
             return;
         }
-        // The interpolated pose may cut through a collider between two steps: each tail is
+        self.output_pose(pack, s);
+        // The pose carried past the last step was collided at no step: each tail is
         // pushed out by this frame's colliders, the rotation rewritten (lanes that acted).
         let mut acted_any = M::NONE;
         for slot in 0..plan.joints.len() {
@@ -764,7 +820,7 @@ impl Ctx<'_> {
                 inside,
                 true,
             );
-            let acted = acted.or(differs(inside, tail));
+            let acted = acted.or(differs(inside, tail)).and(pass);
             if !acted.any() {
                 continue;
             }
@@ -815,6 +871,7 @@ impl Ctx<'_> {
             pack.prev_tail[i] = V3::select(lanes, stored, pack.prev_tail[i]);
             pack.rotation[i] = Q::select(lanes, rest, pack.rotation[i]);
             pack.rotation_before[i] = Q::select(lanes, rest, pack.rotation_before[i]);
+            pack.rotation_older[i] = Q::select(lanes, rest, pack.rotation_older[i]);
             bad = bad.or(stored.finite().not());
         }
         bad

@@ -174,9 +174,11 @@ pub(crate) struct Pack {
     pub(crate) length: Vec<F>,
     pub(crate) stale_tail: Vec<V3>,
     pub(crate) rotation: Vec<Q>,
-    /// Fixed mode: the rotations one step before `rotation` (unused in the other modes).
+    /// Fixed mode: the rotations one and two steps before `rotation` (unused in the other
+    /// modes).
     pub(crate) rotation_before: Vec<Q>,
-    /// The rotations the last frame wrote (fixed mode: between the last two steps).
+    pub(crate) rotation_older: Vec<Q>,
+    /// The rotations the last frame wrote (fixed mode: carried past the last step).
     pub(crate) out_rotation: Vec<Q>,
     /// Fixed mode: last frame's animated locals (per plan slot) and each character's
     /// recent transforms, and the time not yet stepped.
@@ -203,6 +205,7 @@ impl Pack {
             stale_tail: vec![zero; links],
             rotation: vec![id; links],
             rotation_before: vec![id; links],
+            rotation_older: vec![id; links],
             out_rotation: vec![id; links],
             prev_locals: vec![Trs::splat(&Transform::IDENTITY); slots],
             paths: vec![CharacterPath::default(); LANES],
@@ -224,6 +227,7 @@ pub(crate) struct LaneState {
     pub(crate) stale_tail: Vec<Vec3>,
     pub(crate) rotation: Vec<Quat>,
     pub(crate) rotation_before: Vec<Quat>,
+    pub(crate) rotation_older: Vec<Quat>,
     pub(crate) out_rotation: Vec<Quat>,
     pub(crate) prev_locals: Vec<Transform>,
     pub(crate) path: CharacterPath,
@@ -242,6 +246,7 @@ impl Pack {
             stale_tail: self.stale_tail.iter().map(|v| v.get(l)).collect(),
             rotation: self.rotation.iter().map(|q| q.get(l)).collect(),
             rotation_before: self.rotation_before.iter().map(|q| q.get(l)).collect(),
+            rotation_older: self.rotation_older.iter().map(|q| q.get(l)).collect(),
             out_rotation: self.out_rotation.iter().map(|q| q.get(l)).collect(),
             prev_locals: self.prev_locals.iter().map(|t| t.get(l)).collect(),
             path: self.paths[l],
@@ -269,6 +274,9 @@ impl Pack {
             d.set(l, *q);
         }
         for (d, q) in self.rotation_before.iter_mut().zip(&s.rotation_before) {
+            d.set(l, *q);
+        }
+        for (d, q) in self.rotation_older.iter_mut().zip(&s.rotation_older) {
             d.set(l, *q);
         }
         for (d, q) in self.out_rotation.iter_mut().zip(&s.out_rotation) {

@@ -110,8 +110,10 @@ pub(crate) struct SpringIo<'a> {
     pub(crate) length: &'a [f32],
     pub(crate) stale_tail: &'a [Vec3],
     pub(crate) rotation: &'a mut [Quat],
-    /// The step before's rotations (fixed mode's output lies between them and `rotation`).
+    /// The step before's rotations, and the one before that (fixed mode's output is the
+    /// quadratic through them and `rotation`, carried past the newest step).
     pub(crate) rotation_before: &'a [Quat],
+    pub(crate) rotation_older: &'a [Quat],
 }
 
 impl SpringIo<'_> {
@@ -290,13 +292,22 @@ impl SpringLanes {
         step_models: &mut [Transform],
         isa: Isa,
     ) {
-        crate::lanes::lerp_transforms_at(prev, now, w, &self.step_read, step_locals, isa);
+        if w >= 1.0 {
+            // A step that ends on the frame takes the frame's pose (the scalar job's).
+            for &j in self.step_read.iter().chain(&self.step_links) {
+                step_locals[j] = now[j];
+            }
+        } else {
+            crate::lanes::lerp_transforms_at(prev, now, w, &self.step_read, step_locals, isa);
+        }
         let read = self.step_read.iter().copied();
         compose_joints(sk, read, None, step_locals, step_models);
-        for &j in &self.step_links {
-            // `Transform::lerp`'s translation and scale.
-            step_locals[j].translation = prev[j].translation.lerp(now[j].translation, w);
-            step_locals[j].scale = prev[j].scale.lerp(now[j].scale, w);
+        if w < 1.0 {
+            for &j in &self.step_links {
+                // `Transform::lerp`'s translation and scale.
+                step_locals[j].translation = prev[j].translation.lerp(now[j].translation, w);
+                step_locals[j].scale = prev[j].scale.lerp(now[j].scale, w);
+            }
         }
     }
 
@@ -338,8 +349,8 @@ impl SpringLanes {
     }
 
     /// The fixed mode's output rotations and pass (`run` and `collide_output` in
-    /// `dynamics/vrm/job.rs`): each link's local rotation `w` of the way from the step
-    /// before's to the last step's (`slerp_shortest`; the last step's from `w` = 1 on);
+    /// `dynamics/vrm/job.rs`): each link's local rotation carried `a` of a step past the
+    /// last step's along the quadratic through the last three (`extrapolate_rotation`);
     /// each link's tail from that pose pushed out of the colliders and settled, the joint
     /// turned where a collider acted; then every model below a link recomputed. Reads
     /// `io.component`, `io.placed`, `io.length` and the models of the joints above the
@@ -349,46 +360,46 @@ impl SpringLanes {
         sk: &Skeleton,
         rig: &VrmRig,
         io: &mut SpringIo<'_>,
-        w: f32,
+        a: f32,
         isa: Isa,
     ) {
         // SAFETY (both): as in `update`.
         #[cfg(target_arch = "x86_64")]
         #[allow(unsafe_code)]
         match isa {
-            Isa::Avx512 => unsafe { self.output_avx512(rig, io, w) },
-            Isa::Avx2 => unsafe { self.output_avx2(rig, io, w) },
-            Isa::Portable => self.output_baseline(rig, io, w),
+            Isa::Avx512 => unsafe { self.output_avx512(rig, io, a) },
+            Isa::Avx2 => unsafe { self.output_avx2(rig, io, a) },
+            Isa::Portable => self.output_baseline(rig, io, a),
         }
         #[cfg(not(target_arch = "x86_64"))]
         {
             let _ = isa;
-            self.output_baseline(rig, io, w);
+            self.output_baseline(rig, io, a);
         }
         self.refresh_below(sk, io.locals, io.models);
     }
 
     #[inline(never)]
-    fn output_baseline(&self, rig: &VrmRig, io: &mut SpringIo<'_>, w: f32) {
-        self.output_lanes::<F>(rig, io, w)
+    fn output_baseline(&self, rig: &VrmRig, io: &mut SpringIo<'_>, a: f32) {
+        self.output_lanes::<F>(rig, io, a)
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
     #[inline(never)]
-    fn output_avx2(&self, rig: &VrmRig, io: &mut SpringIo<'_>, w: f32) {
-        self.output_lanes::<Fa>(rig, io, w)
+    fn output_avx2(&self, rig: &VrmRig, io: &mut SpringIo<'_>, a: f32) {
+        self.output_lanes::<Fa>(rig, io, a)
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512f,avx512dq,avx512vl,avx512bw")]
     #[inline(never)]
-    fn output_avx512(&self, rig: &VrmRig, io: &mut SpringIo<'_>, w: f32) {
-        self.output_lanes::<Fz>(rig, io, w)
+    fn output_avx512(&self, rig: &VrmRig, io: &mut SpringIo<'_>, a: f32) {
+        self.output_lanes::<Fz>(rig, io, a)
     }
 
     #[inline(always)]
-    fn output_lanes<T: Lane>(&self, rig: &VrmRig, io: &mut SpringIo<'_>, w: f32) {
+    fn output_lanes<T: Lane>(&self, rig: &VrmRig, io: &mut SpringIo<'_>, a: f32) {
         let comp = Trs::<T>::of(&Trs::splat(&io.component));
         io.place_in_lanes();
         for g in &self.groups {
@@ -396,17 +407,19 @@ impl SpringLanes {
             let mut above = Trs::<T>::of(&Trs::splat(&Transform::IDENTITY));
             for (d, row) in g.rows.iter().enumerate() {
                 let (parent, mut local) = io.row_pose(row, d, above);
-                // The output rotation, between the last two steps'.
-                let (mut before, mut last) = (Q::splat(Quat::IDENTITY), Q::splat(Quat::IDENTITY));
+                // The output rotation, carried past the last step's.
+                let id = Q::splat(Quat::IDENTITY);
+                let (mut older, mut before, mut last) = (id, id, id);
                 for l in 0..LANES {
                     let i = row.link[l];
+                    older.set(l, io.rotation_older[i]);
                     before.set(l, io.rotation_before[i]);
                     last.set(l, io.rotation[i]);
                 }
-                local.r = if w >= 1.0 {
+                local.r = if a <= 0.0 {
                     Q::of(last)
                 } else {
-                    Q::<T>::of(before).slerp_shortest(Q::of(last), T::splat(w))
+                    Q::<T>::of(last).extrapolate(Q::of(older), Q::of(before), T::splat(a))
                 };
                 let between = local.r.f();
                 for l in 0..row.n {
