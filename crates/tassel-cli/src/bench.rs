@@ -1,5 +1,8 @@
-//! `tassel bench`: ns per joint-step for a synthetic character, single thread.
+//! `tassel bench [FILE]`: ns per joint-step and µs per frame, for a synthetic character
+//! (16 strands of 8 joints, 8 colliders) or the user's own file.
 
+use crate::simulate::Mode;
+use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Instant;
 use tassel::crowd::{ChainCrowd, CrowdPose, Isa, SimdUse, VrmCrowd};
@@ -11,6 +14,13 @@ use tassel::{builtin, CharacterSim, Transform};
 /// Options of `tassel bench`.
 #[derive(clap::Args)]
 pub struct Args {
+    /// Your own character (.glb, .gltf, .vrm): its VRM springs, and the chains, springs,
+    /// cloths and ropes of --rig, on its rest pose carried along the bench's motion.
+    /// Without it, the bench rig: 16 strands of 8 joints around 8 colliders.
+    file: Option<PathBuf>,
+    /// With FILE: a rig file (TOML); optional for a VRM.
+    #[arg(long, requires = "file")]
+    rig: Option<PathBuf>,
     /// Frames per measurement.
     #[arg(long, default_value_t = 2000)]
     frames: usize,
@@ -18,11 +28,11 @@ pub struct Args {
     #[arg(long, default_value_t = 11)]
     runs: usize,
     /// Run the same joints and colliders as VRM spring bones in this mode instead of
-    /// chains.
+    /// chains. With FILE: the mode of its solvers (default `fixed`).
     #[arg(long, value_enum)]
     vrm: Option<VrmBenchMode>,
     /// The built-in character's skirt (one bone cloth, 4 leg capsules) instead.
-    #[arg(long, conflicts_with = "vrm")]
+    #[arg(long, conflicts_with_all = ["vrm", "file"])]
     cloth: bool,
     /// A crowd of this many characters, each on its own phase of the motion, advanced
     /// together every frame: chains and VRM springs (any mode) through the crowd path
@@ -85,8 +95,34 @@ enum VrmBenchMode {
     ThreeVrm,
 }
 
+/// The user's file as a bench character, in the mode of `--vrm` (default fixed).
+fn file_character(a: &Args, path: &PathBuf) -> Result<(CharacterSim, usize, String), String> {
+    let subject = crate::subject::load(Some(path), false, a.rig.as_ref())?;
+    let mode = match a.vrm.unwrap_or(VrmBenchMode::Fixed) {
+        VrmBenchMode::Spec => Mode::Spec,
+        VrmBenchMode::Fixed => Mode::Fixed,
+        VrmBenchMode::ThreeVrm => Mode::ThreeVrm,
+    };
+    let (sim, mode) = subject.sim(Some(mode))?;
+    let simulated = sim.simulated_joints().len();
+    if simulated == 0 {
+        return Err(format!("{}: nothing to simulate", subject.name));
+    }
+    let what = format!(
+        "{} ({} nodes; {} VRM spring joints{}), {mode:?} mode, its rest pose on the bench motion, 60 Hz frames",
+        subject.name,
+        subject.skeleton.len(),
+        sim.vrm().links.len(),
+        if a.rig.is_some() { ", and its rig" } else { "" },
+    );
+    Ok((sim, simulated, what))
+}
+
 /// One bench character: the simulation, how many joints it simulates, what it is.
 fn character(a: &Args) -> Result<(CharacterSim, usize, String), String> {
+    if let Some(path) = &a.file {
+        return file_character(a, path);
+    }
     let (chains, joints, colliders) = (16, 8, 8);
     let (sk, rig) = builtin::bench_character(chains, joints, colliders);
     if a.cloth {
@@ -225,7 +261,17 @@ fn crowd(a: &Args, n: usize) -> Result<(), String> {
     }
     let threads = a.threads.min(n);
     let frames = a.frames.max(1);
-    let crowd_path = !a.cloth;
+    // A file's character steps as a VRM crowd when its solvers are VRM springs alone,
+    // else one `CharacterSim` each.
+    let file_crowd = match &a.file {
+        Some(_) => {
+            let (sim, _, _) = character(a)?;
+            let only_vrm = sim.simulated_joints().len() == sim.vrm().links.len();
+            only_vrm.then(|| (sim.skeleton().clone(), sim.vrm().clone()))
+        }
+        None => None,
+    };
+    let crowd_path = !a.cloth && (a.file.is_none() || file_crowd.is_some());
     if crowd_path && a.simd == SimdBench::Scalar {
         return Err(
             "--simd scalar: the crowd path has only lanes (its scalar reference is one \
@@ -239,7 +285,10 @@ fn crowd(a: &Args, n: usize) -> Result<(), String> {
         None
     };
     let (what, joints, per_frame, path) = if crowd_path {
-        let (what, joints, t) = if a.vrm.is_some() {
+        let (what, joints, t) = if let Some((sk, rig)) = file_crowd {
+            let (_, joints, what) = character(a)?;
+            crowd_of(a, n, threads, frames, what, joints, sk, rig)?
+        } else if a.vrm.is_some() {
             vrm_crowd(a, n, threads, frames)?
         } else {
             chain_crowd(a, n, threads, frames)?
@@ -347,6 +396,22 @@ fn vrm_crowd(
     let (sk, bones) = builtin::bench_vrm(16, 8, 8);
     let options = vrm_options(a.vrm.unwrap_or(VrmBenchMode::Spec));
     let rig = VrmRig::new(&sk, &bones, options).map_err(|e| e.to_string())?;
+    crowd_of(a, n, threads, frames, what, joints, sk, rig)
+}
+
+/// A VRM crowd of `n` characters of one kind (`sk`, `rig`) on the bench motion: seconds
+/// per frame (median).
+#[allow(clippy::too_many_arguments)]
+fn crowd_of(
+    a: &Args,
+    n: usize,
+    threads: usize,
+    frames: usize,
+    what: String,
+    joints: usize,
+    sk: tassel::Skeleton,
+    rig: VrmRig,
+) -> Result<(String, usize, f64), String> {
     let rest = sk.rest().to_vec();
     let mut crowd = VrmCrowd::new(Arc::new(sk), Arc::new(rig)).map_err(|e| e.to_string())?;
     crowd.set_simd(a.simd.simd_use());

@@ -582,6 +582,89 @@ fn bench_runs_chains_and_vrm_springs() {
     }
 }
 
+/// `tassel bench FILE`: the user's own character, one and a crowd; the joint count read
+/// from the file by hand (`smoke_spring.vrm`: one spring of three joints); a glTF with a
+/// rig steps one `CharacterSim` per member; a file that does not exist or a glTF without
+/// springs or rig is refused with its name.
+#[test]
+fn bench_of_a_users_file() {
+    let Some(vrm) = testdata("vrm/smoke_spring.vrm") else {
+        return;
+    };
+    for mode in ["spec", "fixed", "three-vrm"] {
+        let out = tassel()
+            .arg("bench")
+            .arg(&vrm)
+            .args(["--vrm", mode, "--frames", "20", "--runs", "1"])
+            .output()
+            .unwrap();
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        assert!(
+            out.status.success(),
+            "{mode}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert!(
+            stdout.contains("smoke_spring.vrm (25 nodes; 3 VRM spring joints)"),
+            "{stdout}"
+        );
+        assert!(
+            stdout.contains("3 simulated joints") && stdout.contains(" us)"),
+            "{stdout}"
+        );
+        let out = tassel()
+            .arg("bench")
+            .arg(&vrm)
+            .args([
+                "--vrm", mode, "--crowd", "20", "--frames", "5", "--runs", "1",
+            ])
+            .output()
+            .unwrap();
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        assert!(out.status.success(), "{mode} crowd");
+        assert!(
+            stdout.lines().next().unwrap().contains("crowd path"),
+            "{stdout}"
+        );
+        assert!(stdout
+            .lines()
+            .last()
+            .unwrap()
+            .starts_with("crowd: 20 characters x 3 joints"));
+    }
+    if let Some(fox) = testdata("gltf/Fox.glb") {
+        let rig =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/rigs/fox.toml");
+        let out = tassel()
+            .arg("bench")
+            .arg(&fox)
+            .arg("--rig")
+            .arg(&rig)
+            .args(["--crowd", "4", "--frames", "5", "--runs", "1"])
+            .output()
+            .unwrap();
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert!(
+            stdout.contains("one CharacterSim per character"),
+            "{stdout}"
+        );
+        let out = tassel().arg("bench").arg(&fox).output().unwrap();
+        assert!(!out.status.success());
+        assert!(String::from_utf8_lossy(&out.stderr).contains("--rig"));
+    }
+    let out = tassel()
+        .args(["bench", "no-such-file.vrm"])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("no-such-file.vrm"));
+}
+
 /// World positions of a sample's tails.
 type Points = Vec<[f64; 3]>;
 
