@@ -203,19 +203,6 @@ pub fn extrapolate_rotation(older: Quat, before: Quat, now: Quat, a: f32) -> Qua
     slerp_shortest(early, late, 0.5 * (a + 2.0))
 }
 
-/// [`extrapolate_rotation`] for points: the quadratic through `older`, `before` and
-/// `now` (steps −2, −1, 0), `a` of a step past the newest (`now` exactly at `a = 0`).
-pub fn extrapolate_point(older: Vec3, before: Vec3, now: Vec3, a: f32) -> Vec3 {
-    if a == 0.0 {
-        return now;
-    }
-    // Lagrange weights of the nodes 0, −1, −2 at `a`.
-    let w_now = 0.5 * (a + 1.0) * (a + 2.0);
-    let w_before = -a * (a + 2.0);
-    let w_older = 0.5 * a * (a + 1.0);
-    now * w_now + before * w_before + older * w_older
-}
-
 /// Whether two vectors are the same bits (unlike `==`, which takes −0 for 0 and no NaN for
 /// itself): what the lane paths compare when they must give the scalar code's bits.
 #[inline]
@@ -555,15 +542,5 @@ mod tests {
             extrapolate_rotation(at(0.0), at(0.3), at(0.7), 0.0),
             at(0.7)
         );
-    }
-
-    /// The point extrapolation reproduces any quadratic exactly.
-    #[test]
-    fn extrapolate_point_is_exact_on_a_quadratic() {
-        let p = |t: f32| Vec3::new(1.0 + 2.0 * t - 0.5 * t * t, 3.0 * t * t, -t);
-        for a in [0.0f32, 0.3, 0.5, 1.0] {
-            let got = extrapolate_point(p(-2.0), p(-1.0), p(0.0), a);
-            assert!((got - p(a)).length() < 1e-5, "a = {a}: {got} vs {}", p(a));
-        }
     }
 }
