@@ -708,10 +708,10 @@ fn refresh(sk: &Skeleton, locals: &[Transform], models: &mut [Transform], from: 
 
 /// Fixed mode: whole steps of `1/step_rate` up to now, each with the animated pose and the
 /// character transform interpolated to its time; remembers the last three step rotations.
-/// Time left over within [`ON_FRAME`](crate::dynamics::path::ON_FRAME) of a step is dropped, and a last step that then ends
-/// on the frame takes the frame's own pose (`locals`, and `models` when `models_given`
-/// says it is their model pose): returns whether it did, so that its rotations are the
-/// frame's output as they are.
+/// Time left over within [`ON_FRAME`](crate::dynamics::path::ON_FRAME) of a step is
+/// dropped, and a last step that then ends on the frame takes the frame's own pose
+/// (`locals`, and `models` when `models_given` says it is their model pose): returns
+/// whether it did, so that its rotations are the frame's output as they are.
 fn run_fixed(
     sk: &Skeleton,
     rig: &VrmRig,
