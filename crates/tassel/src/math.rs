@@ -186,23 +186,6 @@ pub fn slerp_shortest(a: Quat, b: Quat, t: f32) -> Quat {
     a.slerp(b, t).normalize()
 }
 
-/// Where a rotation sampled at three evenly spaced steps goes `a` (0..=1) of a step past
-/// the newest: the quadratic through `older` (two steps back), `before` (one step back)
-/// and `now`, built from slerps as Neville's scheme builds a polynomial from lines. At
-/// `a = 0` it is `now` exactly. Fixed mode's output between steps: a quadratic, so that
-/// the output does not jump at each step by the curve's bend as a line would (its jump is
-/// of the third order in the step).
-pub fn extrapolate_rotation(older: Quat, before: Quat, now: Quat, a: f32) -> Quat {
-    if a == 0.0 {
-        return now;
-    }
-    // Lines through (−2, older)–(−1, before) and (−1, before)–(0, now), at `a`.
-    let early = slerp_shortest(older, before, 2.0 + a);
-    let late = slerp_shortest(before, now, 1.0 + a);
-    // Neville: the quadratic is the line through them, (a + 2) / 2 of the way.
-    slerp_shortest(early, late, 0.5 * (a + 2.0))
-}
-
 /// Whether two vectors are the same bits (unlike `==`, which takes −0 for 0 and no NaN for
 /// itself): what the lane paths compare when they must give the scalar code's bits.
 #[inline]
@@ -497,50 +480,5 @@ mod tests {
         assert!((q - Vec3::new(0.5, 0.0, 0.0)).length() < 1e-6);
         let q = closest_point_on_triangle(Vec3::new(1.0, 1.0, 0.0), a, b, c);
         assert!((q - Vec3::new(0.5, 0.5, 0.0)).length() < 1e-6);
-    }
-
-    /// The rotation extrapolation follows a turn about one axis whose angle is a
-    /// quadratic in time (a uniform turn, an accelerating one) to rounding (7e-8 rad
-    /// measured), where a line through the last two steps misses by the bend,
-    /// 0.05·a·(1 + a) rad here.
-    #[test]
-    fn extrapolate_rotation_follows_a_quadratic_turn() {
-        let axis = Vec3::new(0.3, 0.9, -0.2).normalize();
-        let at = |angle: f32| Quat::from_axis_angle(axis, angle);
-        // The angle between two rotations from the vector part (acos cannot tell angles
-        // under ≈ 7e-4 rad apart in f32).
-        let apart = |p: Quat, q: Quat| {
-            let d = p.inverse() * q;
-            2.0 * Vec3::new(d.x, d.y, d.z).length().min(1.0).asin()
-        };
-        // Uniform: 0.1 rad a step.
-        for a in [0.0, 0.25, 0.5, 0.999] {
-            let got = extrapolate_rotation(at(0.0), at(0.1), at(0.2), a);
-            let want = at(0.2 + 0.1 * a);
-            let err = apart(got, want);
-            println!("uniform, a = {a}: {err:e} rad");
-            assert!(err < 2e-4, "a = {a}: {got} vs {want}");
-        }
-        // Accelerating: angle = t² (steps at t = −2, −1, 0 from t = 2).
-        let angle = |t: f32| 0.05 * (t + 2.0) * (t + 2.0);
-        for a in [0.25f32, 0.5, 0.75] {
-            let got = extrapolate_rotation(at(angle(-2.0)), at(angle(-1.0)), at(angle(0.0)), a);
-            let want = at(angle(a));
-            let line = slerp_shortest(at(angle(-1.0)), at(angle(0.0)), 1.0 + a);
-            let err = apart(got, want);
-            println!(
-                "accelerating, a = {a}: {err:e} rad, the line {:e}",
-                apart(line, want)
-            );
-            assert!(err < 2e-4, "a = {a}: off by {err} rad");
-            assert!(
-                apart(line, want) > 0.04 * a * (1.0 + a),
-                "the line bends too"
-            );
-        }
-        assert_eq!(
-            extrapolate_rotation(at(0.0), at(0.3), at(0.7), 0.0),
-            at(0.7)
-        );
     }
 }

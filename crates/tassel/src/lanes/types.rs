@@ -1138,16 +1138,6 @@ impl<T: Lane> Q<T> {
         let b = Q::select(self.dot(b).lt(T::splat(0.0)), b.neg(), b);
         self.slerp(b, t).normalize()
     }
-
-    /// [`crate::math::extrapolate_rotation`] per lane: the quadratic through `older`,
-    /// `before` and `now` (`self`), `a` (0..=1) of a step past `now`.
-    #[inline(always)]
-    pub fn extrapolate(self, older: Q<T>, before: Q<T>, a: T) -> Q<T> {
-        let early = older.slerp_shortest(before, T::splat(2.0) + a);
-        let late = before.slerp_shortest(self, T::splat(1.0) + a);
-        let out = early.slerp_shortest(late, T::splat(0.5) * (a + T::splat(2.0)));
-        Q::select(a.le(T::splat(0.0)), self, out)
-    }
 }
 
 impl<T: Lane> V3<T> {
@@ -1551,26 +1541,6 @@ mod tests {
                 assert_eq!(
                     bits4(la.r.slerp_shortest(lb.r, lw).get(i)),
                     bits4(slerp_shortest(ta[i].rotation, tb[i].rotation, w[i]))
-                );
-                // Fixed mode's output past the newest step (`w` as the share `a`).
-                let older = (ta[i].rotation * Quat::from_rotation_z(0.3 * w[i])).normalize();
-                let lo = Q::splat(Quat::IDENTITY);
-                let mut lolder = lo;
-                for k in 0..LANES {
-                    lolder.set(
-                        k,
-                        (ta[k].rotation * Quat::from_rotation_z(0.3 * w[k])).normalize(),
-                    );
-                }
-                assert_eq!(
-                    bits4(lb.r.extrapolate(lolder, la.r, lw).get(i)),
-                    bits4(crate::math::extrapolate_rotation(
-                        older,
-                        ta[i].rotation,
-                        tb[i].rotation,
-                        w[i]
-                    )),
-                    "extrapolation, round {round} lane {i}"
                 );
                 let n = normalize_or(ta[i].translation, Vec3::Y);
                 assert_eq!(bits3(ortho.get(i)), bits3(n.any_orthonormal_vector()));

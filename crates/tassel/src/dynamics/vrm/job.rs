@@ -9,7 +9,7 @@ use crate::dynamics::path::{CharacterPath, FixedClock};
 use crate::dynamics::vrm::lanes::springs::{SpringIo, SpringLanes};
 use crate::error::{Error, Result};
 use crate::lanes::{Isa, SimdUse};
-use crate::math::{extrapolate_rotation, normalize_or, rotation_arc, Transform};
+use crate::math::{normalize_or, rotation_arc, Transform};
 use crate::skeleton::Skeleton;
 use glam::{Quat, Vec3};
 
@@ -25,10 +25,15 @@ pub struct VrmState {
     /// three-vrm mode: each link's tail node (world) at the end of the previous frame.
     stale_tail: Vec<Vec3>,
     rotation: Vec<Quat>,
-    /// Fixed mode: the rotations one and two steps before `rotation` (the output between
-    /// steps is the quadratic through the three).
     rotation_before: Vec<Quat>,
-    rotation_older: Vec<Quat>,
+    /// Fixed mode's output step: the state it starts from, put back after it.
+    kept_current: Vec<Vec3>,
+    kept_prev: Vec<Vec3>,
+    kept_rotation: Vec<Quat>,
+    /// The share of a step an update carries the motion (inertia) and the forces
+    /// (stiffness, gravity) by: (1, 1) for a step; fixed mode's output step (`a` of a step)
+    /// `(a, a(1 + a)/2)`, as a Verlet step of `a·h` would.
+    carry: (f32, f32),
     placed: Vec<PlacedVrmCollider>,
     // Fixed mode: last frame's animated input and the scratch pose of a step.
     prev_locals: Vec<Transform>,
@@ -60,7 +65,10 @@ impl VrmState {
             stale_tail: vec![Vec3::ZERO; l],
             rotation: vec![Quat::IDENTITY; l],
             rotation_before: vec![Quat::IDENTITY; l],
-            rotation_older: vec![Quat::IDENTITY; l],
+            kept_current: vec![Vec3::ZERO; l],
+            kept_prev: vec![Vec3::ZERO; l],
+            kept_rotation: vec![Quat::IDENTITY; l],
+            carry: (1.0, 1.0),
             placed: vec![none; rig.colliders.len()],
             prev_locals: vec![Transform::IDENTITY; n],
             step_locals: vec![Transform::IDENTITY; n],
@@ -104,8 +112,7 @@ impl VrmState {
             length: &self.length,
             stale_tail: &self.stale_tail,
             rotation: &mut self.rotation,
-            rotation_before: &self.rotation_before,
-            rotation_older: &self.rotation_older,
+            carry: self.carry,
         }
     }
 
@@ -280,15 +287,17 @@ impl VrmJob<'_> {
         // Whether the lane path updated every link's model (then only the joints below
         // the links need their models recomputed at the end).
         let mut lanes_ran = false;
-        // Whether `models` is still the model pose of the animated `locals` given (no
-        // reset wrote it with the lazy refresh's root rule).
-        let mut models_given = rig.constraints.list.is_empty();
+        // Whether `models` is the model pose of the animated `locals` as given (node
+        // constraints write it with the lazy refresh's root rule).
+        let models_given = rig.constraints.list.is_empty();
         // Fixed mode: whether this frame's last step ended on the frame, on its pose and
         // colliders (then its rotations are the output, pushed out already).
         let mut on_frame = false;
+        // Whether a reset wrote `models` (its lazy refresh's root rule: the output pose is
+        // composed again whole).
+        let mut was_reset = state.needs_reset;
         if state.needs_reset {
             reset(skeleton, rig, state, &component, locals, models);
-            models_given = false;
         } else {
             match opts.mode {
                 VrmMode::Spec | VrmMode::ThreeVrm => {
@@ -311,8 +320,8 @@ impl VrmJob<'_> {
         {
             reset(skeleton, rig, state, &component, locals, models);
             lanes_ran = false;
-            models_given = false;
             on_frame = false;
+            was_reset = true;
         }
         // A last step on this frame's own pose in lanes wrote the output's models of the
         // links (the joints below them are left to `refresh_below`, as in the spec
@@ -324,47 +333,24 @@ impl VrmJob<'_> {
         }
         state.prev_locals.copy_from_slice(locals);
         state.prev_component = component;
-        // Output: the last rotations; in fixed mode the newest step's carried `a` of a
-        // step on (the time not yet stepped) along the quadratic through the last three.
-        let fixed = opts.mode == VrmMode::Fixed;
-        let a = if fixed {
-            (state.accumulator * opts.step_rate).clamp(0.0, 1.0)
+        // Output: the last step's rotations; in fixed mode, unless that step ended on
+        // this frame, an output step: the springs carried from the last step to the
+        // frame's time (`a` of a step) on the frame's pose and colliders, not kept.
+        if opts.mode == VrmMode::Fixed && !on_frame {
+            let a = (state.accumulator * opts.step_rate).clamp(0.0, 1.0);
+            lanes_ran =
+                output_step(skeleton, rig, state, &component, a, locals, models) && !was_reset;
         } else {
-            0.0
-        };
-        // Fixed mode's output pass: unless the last step ended on this frame, the output
-        // is pushed out of this frame's colliders (and limited).
-        let output_pass = fixed && !on_frame;
-        if output_pass {
-            // This frame's colliders, from the animated pose.
-            place_colliders(rig, state, &component, models);
-        }
-        // Fixed mode's output pass in lanes: it turns the links to their output rotations
-        // (the same slerps, eight at a time) and composes every link's model from its
-        // parent's, then the joints below the links.
-        let lane_output =
-            output_pass && !rig.link_colliders.is_empty() && lane_plan(rig, state).is_some();
-        for (i, l) in rig.links.iter().enumerate().filter(|_| !lane_output) {
-            locals[l.joint].rotation = extrapolate_rotation(
-                state.rotation_older[i],
-                state.rotation_before[i],
-                state.rotation[i],
-                a,
-            );
+            for (i, l) in rig.links.iter().enumerate() {
+                locals[l.joint].rotation = state.rotation[i];
+            }
         }
         match (&rig.lanes, lanes_ran && rig.constraints.list.is_empty()) {
             // The links' models are those of their new rotations already (the lane path
             // composes them as this pass would), the joints no link moves keep the models
             // given: only the joints below the links are left.
             (Some(lanes), true) => lanes.refresh_below(skeleton, locals, models),
-            // With the models given elsewhere, the output pass leaves nothing to compose.
-            (Some(_), false) if lane_output && models_given => {}
             _ => crate::pose::local_to_model_into(skeleton, locals, models),
-        }
-        if output_pass && (!rig.link_colliders.is_empty() || rig.has_limits()) {
-            // The pose carried past the last step was collided at no step: it is pushed
-            // out by this frame's colliders (and limited) like a step's tail.
-            collide_output(skeleton, rig, state, &component, a, locals, models);
         }
         if opts.mode == VrmMode::ThreeVrm {
             // Where each tail node ends this frame: next frame's bone length measures to it.
@@ -379,12 +365,13 @@ fn lane_plan<'a>(rig: &'a VrmRig, state: &VrmState) -> Option<&'a SpringLanes> {
     rig.lanes.as_ref().filter(|_| state.simd != SimdUse::Scalar)
 }
 
-/// Fixed-mode output pass: each link's tail (from the output pose) pushed out of this
-/// frame's colliders with the spec's push and length projection, the rotation rewritten.
-/// The lane path also writes the links' output rotations (the newest step's carried `a`
-/// of a step on, [`extrapolate_rotation`]) first; the scalar path finds them written by
-/// the caller.
-fn collide_output(
+/// Fixed mode's output step: one update of `a` (0..=1) of a step from the last step's
+/// state, on this frame's pose (`locals`, `models`: its model pose) and colliders, with
+/// the motion carried by `a` and the forces by `a(1 + a)/2` (a Verlet step of `a·h`: at
+/// `a = 1` a whole step, at 0 the last step's tails held in place), pushed out of the
+/// colliders and limited as a step is. It writes the links' output rotations and models;
+/// the state is put back as it was. Returns whether the lane path ran (as [`update`]).
+fn output_step(
     sk: &Skeleton,
     rig: &VrmRig,
     state: &mut VrmState,
@@ -392,54 +379,19 @@ fn collide_output(
     a: f32,
     locals: &mut [Transform],
     models: &mut [Transform],
-) {
-    if let Some(lanes) = lane_plan(rig, state) {
-        // The same results, several springs at a time (`dynamics/vrm/lanes/springs.rs`), which
-        // also turn the links to their output rotations (`a`).
-        let isa = Isa::of(state.simd);
-        let mut io = state.lane_io(component, 0.0, VrmMode::Fixed, locals, models);
-        lanes.collide_output(sk, rig, &mut io, a, isa);
-        return;
-    }
-    let mut stale_from = sk.len();
-    for (i, l) in rig.links.iter().enumerate() {
-        if l.colliders.is_empty() && l.limit.is_none() {
-            continue;
-        }
-        if stale_from <= l.joint {
-            refresh(sk, locals, models, stale_from, l.joint);
-            stale_from = l.joint + 1;
-        }
-        let joint_world = *component * models[l.joint];
-        let tail = joint_world.transform_point(l.tail_local);
-        let parent_world = parent_world(l, component, models);
-        let position = joint_world.translation;
-        // The blend between two limited steps can leave the limit: the output is limited
-        // too, then pushed (and limited after each push) like a step's tail.
-        let inside = limited(l, parent_world.rotation, position, tail, state.length[i]);
-        let (next, acted) = collide_tail(
-            rig,
-            state,
-            l,
-            parent_world.rotation,
-            position,
-            state.length[i],
-            rest_dir(l, &parent_world),
-            inside,
-            true,
-        );
-        if !acted && inside == tail {
-            continue;
-        }
-        turn_toward(l, &parent_world, next, locals, models);
-        stale_from = stale_from.min(l.joint + 1);
-    }
-    if stale_from < sk.len() {
-        // The whole pose as `LocalToModelJob` computes it (a skeleton root under the
-        // identity; the lazy refresh takes a root's local as its model): the job's output
-        // is the model pose of its locals.
-        crate::pose::local_to_model_into(sk, locals, models);
-    }
+) -> bool {
+    let h = 1.0 / rig.options.step_rate;
+    place_colliders(rig, state, component, models);
+    state.kept_current.copy_from_slice(&state.current_tail);
+    state.kept_prev.copy_from_slice(&state.prev_tail);
+    state.kept_rotation.copy_from_slice(&state.rotation);
+    state.carry = (a, a);
+    let lanes_ran = update(sk, rig, state, component, h, VrmMode::Fixed, locals, models);
+    state.carry = (1.0, 1.0);
+    std::mem::swap(&mut state.current_tail, &mut state.kept_current);
+    std::mem::swap(&mut state.prev_tail, &mut state.kept_prev);
+    std::mem::swap(&mut state.rotation, &mut state.kept_rotation);
+    lanes_ran
 }
 
 /// The spec's initialisation from the given pose: joints at their rest rotation, tails
@@ -468,7 +420,6 @@ fn reset(
         state.prev_tail[i] = stored;
         state.rotation[i] = l.rest_local.rotation;
         state.rotation_before[i] = l.rest_local.rotation;
-        state.rotation_older[i] = l.rest_local.rotation;
     }
     record_tails(rig, state, component, models);
     state.accumulator = 0.0;
@@ -539,9 +490,10 @@ fn update(
         // Verlet: inertia, stiffness toward the rest direction under the current parent,
         // gravity; then back to the bone length.
         let rest_dir = rest_dir(l, &parent_world);
-        let inertia = (current - prev) * (1.0 - l.drag_force);
-        let stiffness = rest_dir * (l.stiffness * dt);
-        let external = l.gravity * dt;
+        let (carry_motion, carry_force) = state.carry;
+        let inertia = (current - prev) * (1.0 - l.drag_force) * carry_motion;
+        let stiffness = rest_dir * (l.stiffness * dt) * carry_force;
+        let external = l.gravity * dt * carry_force;
         let length = match (mode, l.tail_joint) {
             // three-vrm re-measures the bone against the tail node's world matrix, which
             // still holds the end of the last frame.
@@ -755,7 +707,6 @@ fn run_fixed(
             }
         }
         place_colliders(rig, state, &comp, &step_models);
-        state.rotation_older.copy_from_slice(&state.rotation_before);
         state.rotation_before.copy_from_slice(&state.rotation);
         update(
             sk,

@@ -14,7 +14,7 @@ use crate::error::Error;
 use crate::lanes::avx::Fa;
 #[cfg(target_arch = "x86_64")]
 use crate::lanes::avx512::Fz;
-use crate::lanes::{differs, rotation_arc_from, Isa, Lane, Mask, Trs, F, LANES, M, Q, V3};
+use crate::lanes::{rotation_arc_from, Isa, Lane, Mask, Trs, F, LANES, M, Q, V3};
 use crate::math::Transform;
 use crate::pose::CrowdPose;
 use crate::skeleton::Skeleton;
@@ -300,6 +300,9 @@ pub(crate) struct Poses<'p, T = F> {
     pub(crate) comp: Trs<T>,
     pub(crate) locals: &'p [Trs],
     pub(crate) models: &'p mut [Trs],
+    /// The share of a step the update carries the motion and the forces by, per lane (the
+    /// scalar job's `carry`: 1 and 1 but in fixed mode's output step).
+    pub(crate) carry: (T, T),
 }
 
 // `match` rather than `Option::map` in the hot path: a closure is a function of its own,
@@ -352,6 +355,7 @@ impl Ctx<'_> {
                     comp: Trs::<T>::of(&comp),
                     locals,
                     models,
+                    carry: (T::splat(1.0), T::splat(1.0)),
                 };
                 self.place_colliders(&poses, placed);
                 self.update(pack, &mut poses, placed, mode, <T::M as Mask>::ALL);
@@ -380,7 +384,7 @@ impl Ctx<'_> {
             }
         }
         if fixed {
-            self.fixed_output(pack, s, again, on_frame);
+            self.fixed_output::<T>(pack, s, again, on_frame);
         } else {
             pack.out_rotation.copy_from_slice(&pack.rotation);
         }
@@ -519,9 +523,10 @@ impl Ctx<'_> {
             None => (current_stored, prev_stored),
         };
         let rest_dir = parent_world.r.mul_vec3(V3::splat(lp.rest_bone));
-        let inertia = (current - prev) * T::splat(lp.keep);
-        let stiffness = rest_dir * T::splat(self.stiffness_dt[i]);
-        let external = V3::splat(self.external[i]);
+        let (carry_motion, carry_force) = poses.carry;
+        let inertia = (current - prev) * T::splat(lp.keep) * carry_motion;
+        let stiffness = rest_dir * T::splat(self.stiffness_dt[i]) * carry_force;
+        let external = V3::<T>::splat(self.external[i]) * carry_force;
         let length = match (mode, lp.tail_slot) {
             (VrmMode::ThreeVrm, Some(_)) => (V3::of(pack.stale_tail[i]) - position).length(),
             _ => T::of(pack.length[i]),
@@ -649,6 +654,7 @@ impl Ctx<'_> {
                     comp: Trs::<T>::of(&comp),
                     locals,
                     models,
+                    carry: (T::splat(1.0), T::splat(1.0)),
                 };
                 self.place_colliders(&poses, placed);
                 self.shift_rotations(pack, active);
@@ -679,6 +685,7 @@ impl Ctx<'_> {
                 comp: Trs::<T>::of(&comp),
                 locals: step_locals,
                 models: step_models,
+                carry: (T::splat(1.0), T::splat(1.0)),
             };
             self.place_colliders(&poses, placed);
             self.shift_rotations(pack, active);
@@ -694,27 +701,31 @@ impl Ctx<'_> {
     }
 
     /// Fixed mode, before a step of the lanes in `active`: each rotation becomes the one a
-    /// step before, that one the one two steps before.
+    /// step before.
     #[inline(always)]
     fn shift_rotations(&self, pack: &mut Pack, active: M) {
         if active == M::ALL {
-            std::mem::swap(&mut pack.rotation_older, &mut pack.rotation_before);
             pack.rotation_before.copy_from_slice(&pack.rotation);
             return;
         }
         for i in 0..pack.rotation.len() {
-            pack.rotation_older[i] =
-                Q::select(active, pack.rotation_before[i], pack.rotation_older[i]);
             pack.rotation_before[i] = Q::select(active, pack.rotation[i], pack.rotation_before[i]);
         }
     }
 
-    /// Fixed mode's output: the last step's rotations carried past it by the time not yet
-    /// stepped, pushed out of this frame's colliders (but in the lanes `on_frame`, whose
-    /// last step ended on this frame and was pushed out of them); and this frame's pose
-    /// kept for the next frame's steps.
+    /// Fixed mode's output: the last step's rotations in the lanes `on_frame` (whose last
+    /// step ended on this frame, on its pose and colliders), else those of an output step
+    /// (the scalar job's `output_step`: `a` of a step from the last step's state on this
+    /// frame's pose and colliders, not kept); and this frame's pose kept for the next
+    /// frame's steps.
     #[inline(always)]
-    pub(crate) fn fixed_output(&self, pack: &mut Pack, s: &mut Scratch, reset: M, on_frame: M) {
+    pub(crate) fn fixed_output<T: Lane>(
+        &self,
+        pack: &mut Pack,
+        s: &mut Scratch,
+        reset: M,
+        on_frame: M,
+    ) {
         let plan = self.plan;
         let opts = &self.rig.options;
         // Last frame's pose for the next steps: the animated locals, with the rest
@@ -727,115 +738,42 @@ impl Ctx<'_> {
             pack.prev_locals[slot] = kept;
         }
         let pass = on_frame.not();
-        let output_pass =
-            pass != M::NONE && (!self.rig.link_colliders.is_empty() || self.rig.has_limits());
-        let comp = s.component;
-        if output_pass {
-            // This frame's colliders: from the animated pose (the reset's pose where
-            // reset), before the output pose is written over it.
-            for slot in 0..plan.joints.len() {
-                s.step_models[slot] = Trs::select(reset, &s.reset_models[slot], &s.models[slot]);
-            }
-            let poses = Poses {
-                comp,
-                locals: &s.locals,
-                models: &mut s.step_models,
-            };
-            self.place_colliders(&poses, &mut s.placed);
+        if pass == M::NONE {
+            pack.out_rotation.copy_from_slice(&pack.rotation);
+            return;
         }
         let mut a = [0.0f32; LANES];
         for lane in 0..LANES {
             a[lane] = (pack.accumulator[lane] * opts.step_rate).clamp(0.0, 1.0);
         }
-        let a = F(a);
-        if a.le(F::splat(0.0)) == M::ALL {
-            pack.out_rotation.copy_from_slice(&pack.rotation);
-        } else {
-            for i in 0..pack.rotation.len() {
-                pack.out_rotation[i] = pack.rotation[i].extrapolate(
-                    pack.rotation_older[i],
-                    pack.rotation_before[i],
-                    a,
-                );
-            }
-        }
-        if !output_pass {
-            // The crowd's output is the rotations (`write_pose` composes the pose).
-            return;
-        }
-        self.output_pose(pack, s);
-        // The pose carried past the last step was collided at no step: each tail is
-        // pushed out by this frame's colliders, the rotation rewritten (lanes that acted).
-        let mut acted_any = M::NONE;
+        let a = T::of(F(a));
+        // This frame's pose (the reset's where reset) and colliders.
         for slot in 0..plan.joints.len() {
-            let parent = match plan.parent[slot] {
-                Some(p) => Some(s.models[p]),
-                None => None,
-            };
-            if acted_any.any() {
-                // The scalar job's refresh below a changed joint (a root: its local).
-                let local = s.step_locals[slot];
-                s.models[slot] = match parent {
-                    Some(p) => p.mul(&local),
-                    None => Trs::select(acted_any, &local, &s.models[slot]),
-                };
-            }
-            let Some(i) = plan.link_at[slot] else {
-                continue;
-            };
-            let lp = &plan.links[i];
-            if lp.colliders.is_empty() && lp.limit.is_none() {
-                continue;
-            }
-            let joint_world = comp.mul(&s.models[slot]);
-            let tail = joint_world.transform_point(V3::splat(lp.tail_local));
-            let parent_world = match &parent {
-                Some(p) => comp.mul(p),
-                None => comp,
-            };
-            let rest_dir = parent_world.r.mul_vec3(V3::splat(lp.rest_bone));
-            // The blend between two limited steps can leave the limit (the scalar job's
-            // `collide_output`).
-            let inside = match &lp.limit {
-                Some(lim) => {
-                    let every = M::NONE.not();
-                    limit_lanes(
-                        lim,
-                        parent_world.r,
-                        joint_world.t,
-                        tail,
-                        pack.length[i],
-                        every,
-                    )
-                }
-                None => tail,
-            };
-            let (next, acted) = self.collide_tail(
-                lp,
-                &s.placed,
-                parent_world.r,
-                joint_world.t,
-                pack.length[i],
-                rest_dir,
-                inside,
-                true,
-            );
-            let acted = acted.or(differs(inside, tail)).and(pass);
-            if !acted.any() {
-                continue;
-            }
-            let rotation = self.turn(lp, &parent_world, next);
-            pack.out_rotation[i] = Q::select(acted, rotation, pack.out_rotation[i]);
-            let mut local = s.step_locals[slot];
-            local.r = pack.out_rotation[i];
-            s.step_locals[slot] = local;
-            let turned = match parent {
-                Some(p) => p.mul(&local),
-                None => local,
-            };
-            s.models[slot] = Trs::select(acted, &turned, &s.models[slot]);
-            acted_any = acted_any.or(acted);
+            s.step_models[slot] = Trs::select(reset, &s.reset_models[slot], &s.models[slot]);
         }
+        s.kept_current.copy_from_slice(&pack.current_tail);
+        s.kept_prev.copy_from_slice(&pack.prev_tail);
+        s.kept_rotation.copy_from_slice(&pack.rotation);
+        let comp = s.component;
+        let Scratch {
+            locals,
+            step_models,
+            placed,
+            ..
+        } = s;
+        let mut poses = Poses {
+            comp: Trs::<T>::of(&comp),
+            locals,
+            models: step_models,
+            carry: (a, a),
+        };
+        self.place_colliders(&poses, placed);
+        let active = <T::M as Mask>::of(pass);
+        self.update(pack, &mut poses, placed, VrmMode::Fixed, active);
+        pack.out_rotation.copy_from_slice(&pack.rotation);
+        std::mem::swap(&mut pack.current_tail, &mut s.kept_current);
+        std::mem::swap(&mut pack.prev_tail, &mut s.kept_prev);
+        std::mem::swap(&mut pack.rotation, &mut s.kept_rotation);
     }
 
     /// The specification's initialisation for the lanes in `lanes`: joints at their rest
@@ -871,7 +809,6 @@ impl Ctx<'_> {
             pack.prev_tail[i] = V3::select(lanes, stored, pack.prev_tail[i]);
             pack.rotation[i] = Q::select(lanes, rest, pack.rotation[i]);
             pack.rotation_before[i] = Q::select(lanes, rest, pack.rotation_before[i]);
-            pack.rotation_older[i] = Q::select(lanes, rest, pack.rotation_older[i]);
             bad = bad.or(stored.finite().not());
         }
         bad

@@ -174,11 +174,10 @@ pub(crate) struct Pack {
     pub(crate) length: Vec<F>,
     pub(crate) stale_tail: Vec<V3>,
     pub(crate) rotation: Vec<Q>,
-    /// Fixed mode: the rotations one and two steps before `rotation` (unused in the other
-    /// modes).
+    /// Fixed mode: the rotations one step before `rotation` (unused in the other modes).
     pub(crate) rotation_before: Vec<Q>,
-    pub(crate) rotation_older: Vec<Q>,
-    /// The rotations the last frame wrote (fixed mode: carried past the last step).
+    /// The rotations the last frame wrote (fixed mode: the last step's, or an output
+    /// step's).
     pub(crate) out_rotation: Vec<Q>,
     /// Fixed mode: last frame's animated locals (per plan slot) and each character's
     /// recent transforms, and the time not yet stepped.
@@ -205,7 +204,6 @@ impl Pack {
             stale_tail: vec![zero; links],
             rotation: vec![id; links],
             rotation_before: vec![id; links],
-            rotation_older: vec![id; links],
             out_rotation: vec![id; links],
             prev_locals: vec![Trs::splat(&Transform::IDENTITY); slots],
             paths: vec![CharacterPath::default(); LANES],
@@ -227,7 +225,6 @@ pub(crate) struct LaneState {
     pub(crate) stale_tail: Vec<Vec3>,
     pub(crate) rotation: Vec<Quat>,
     pub(crate) rotation_before: Vec<Quat>,
-    pub(crate) rotation_older: Vec<Quat>,
     pub(crate) out_rotation: Vec<Quat>,
     pub(crate) prev_locals: Vec<Transform>,
     pub(crate) path: CharacterPath,
@@ -246,7 +243,6 @@ impl Pack {
             stale_tail: self.stale_tail.iter().map(|v| v.get(l)).collect(),
             rotation: self.rotation.iter().map(|q| q.get(l)).collect(),
             rotation_before: self.rotation_before.iter().map(|q| q.get(l)).collect(),
-            rotation_older: self.rotation_older.iter().map(|q| q.get(l)).collect(),
             out_rotation: self.out_rotation.iter().map(|q| q.get(l)).collect(),
             prev_locals: self.prev_locals.iter().map(|t| t.get(l)).collect(),
             path: self.paths[l],
@@ -276,9 +272,6 @@ impl Pack {
         for (d, q) in self.rotation_before.iter_mut().zip(&s.rotation_before) {
             d.set(l, *q);
         }
-        for (d, q) in self.rotation_older.iter_mut().zip(&s.rotation_older) {
-            d.set(l, *q);
-        }
         for (d, q) in self.out_rotation.iter_mut().zip(&s.out_rotation) {
             d.set(l, *q);
         }
@@ -301,6 +294,10 @@ pub(crate) struct Scratch {
     pub(crate) reset_models: Vec<Trs>,
     pub(crate) step_locals: Vec<Trs>,
     pub(crate) step_models: Vec<Trs>,
+    /// Fixed mode's output step: the state it starts from, put back after it.
+    pub(crate) kept_current: Vec<V3>,
+    pub(crate) kept_prev: Vec<V3>,
+    pub(crate) kept_rotation: Vec<Q>,
     pub(crate) placed: Vec<Placed>,
     pub(crate) full_locals: Vec<Transform>,
     pub(crate) full_models: Vec<Transform>,
@@ -317,6 +314,9 @@ impl Scratch {
             reset_models: vec![id; plan.joints.len()],
             step_locals: vec![id; plan.joints.len()],
             step_models: vec![id; plan.joints.len()],
+            kept_current: vec![zero; plan.links.len()],
+            kept_prev: vec![zero; plan.links.len()],
+            kept_rotation: vec![Q::splat(Quat::IDENTITY); plan.links.len()],
             placed: vec![
                 Placed {
                     a: zero,

@@ -110,10 +110,9 @@ pub(crate) struct SpringIo<'a> {
     pub(crate) length: &'a [f32],
     pub(crate) stale_tail: &'a [Vec3],
     pub(crate) rotation: &'a mut [Quat],
-    /// The step before's rotations, and the one before that (fixed mode's output is the
-    /// quadratic through them and `rotation`, carried past the newest step).
-    pub(crate) rotation_before: &'a [Quat],
-    pub(crate) rotation_older: &'a [Quat],
+    /// The share of a step the update carries the motion and the forces by (the scalar
+    /// job's `carry`: (1, 1) but in fixed mode's output step).
+    pub(crate) carry: (f32, f32),
 }
 
 impl SpringIo<'_> {
@@ -348,134 +347,6 @@ impl SpringLanes {
         self.update_baseline(rig, io)
     }
 
-    /// The fixed mode's output rotations and pass (`run` and `collide_output` in
-    /// `dynamics/vrm/job.rs`): each link's local rotation carried `a` of a step past the
-    /// last step's along the quadratic through the last three (`extrapolate_rotation`);
-    /// each link's tail from that pose pushed out of the colliders and settled, the joint
-    /// turned where a collider acted; then every model below a link recomputed. Reads
-    /// `io.component`, `io.placed`, `io.length` and the models of the joints above the
-    /// links; writes the links' local rotations and the models of the links and below.
-    pub(crate) fn collide_output(
-        &self,
-        sk: &Skeleton,
-        rig: &VrmRig,
-        io: &mut SpringIo<'_>,
-        a: f32,
-        isa: Isa,
-    ) {
-        // SAFETY (both): as in `update`.
-        #[cfg(target_arch = "x86_64")]
-        #[allow(unsafe_code)]
-        match isa {
-            Isa::Avx512 => unsafe { self.output_avx512(rig, io, a) },
-            Isa::Avx2 => unsafe { self.output_avx2(rig, io, a) },
-            Isa::Portable => self.output_baseline(rig, io, a),
-        }
-        #[cfg(not(target_arch = "x86_64"))]
-        {
-            let _ = isa;
-            self.output_baseline(rig, io, a);
-        }
-        self.refresh_below(sk, io.locals, io.models);
-    }
-
-    #[inline(never)]
-    fn output_baseline(&self, rig: &VrmRig, io: &mut SpringIo<'_>, a: f32) {
-        self.output_lanes::<F>(rig, io, a)
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    #[inline(never)]
-    fn output_avx2(&self, rig: &VrmRig, io: &mut SpringIo<'_>, a: f32) {
-        self.output_lanes::<Fa>(rig, io, a)
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx512f,avx512dq,avx512vl,avx512bw")]
-    #[inline(never)]
-    fn output_avx512(&self, rig: &VrmRig, io: &mut SpringIo<'_>, a: f32) {
-        self.output_lanes::<Fz>(rig, io, a)
-    }
-
-    #[inline(always)]
-    fn output_lanes<T: Lane>(&self, rig: &VrmRig, io: &mut SpringIo<'_>, a: f32) {
-        let comp = Trs::<T>::of(&Trs::splat(&io.component));
-        io.place_in_lanes();
-        for g in &self.groups {
-            let colliders = &rig.link_colliders[g.colliders.clone()];
-            let mut above = Trs::<T>::of(&Trs::splat(&Transform::IDENTITY));
-            for (d, row) in g.rows.iter().enumerate() {
-                let (parent, mut local) = io.row_pose(row, d, above);
-                // The output rotation, carried past the last step's.
-                let id = Q::splat(Quat::IDENTITY);
-                let (mut older, mut before, mut last) = (id, id, id);
-                for l in 0..LANES {
-                    let i = row.link[l];
-                    older.set(l, io.rotation_older[i]);
-                    before.set(l, io.rotation_before[i]);
-                    last.set(l, io.rotation[i]);
-                }
-                local.r = if a <= 0.0 {
-                    Q::of(last)
-                } else {
-                    Q::<T>::of(last).extrapolate(Q::of(older), Q::of(before), T::splat(a))
-                };
-                let between = local.r.f();
-                for l in 0..row.n {
-                    io.locals[row.joint[l]].rotation = between.get(l);
-                }
-                // The joint's model from the output rotation (the scalar refresh's).
-                let own = parent.mul(&local);
-                let mut model = own;
-                let mut turned = None;
-                if !colliders.is_empty() {
-                    let joint_world = comp.mul(&own);
-                    let tail = joint_world.transform_point(V3::of(row.tail_local));
-                    let parent_world = comp.mul(&parent);
-                    let rest_dir = parent_world.r.mul_vec3(V3::of(row.rest_bone));
-                    let mut length = F::splat(0.0);
-                    for l in 0..LANES {
-                        length.0[l] = io.length[row.link[l]];
-                    }
-                    let (next, acted) = collide_tail(
-                        colliders,
-                        &rig.colliders,
-                        io.lane_placed,
-                        T::of(row.hit_radius),
-                        joint_world.t,
-                        T::of(length),
-                        rest_dir,
-                        tail,
-                        true,
-                        None,
-                    );
-                    if acted.any() {
-                        let rotation = row.turn(&parent_world, next);
-                        let new = Trs {
-                            t: own.t,
-                            r: parent.r.mul_quat(rotation).normalize(),
-                            s: own.s,
-                        };
-                        model = Trs::select(acted, &new, &own);
-                        turned = Some((acted.m(), rotation.f()));
-                    }
-                }
-                let model_f = model.f();
-                for l in 0..row.n {
-                    let j = row.joint[l];
-                    if let Some((acted, rotation)) = &turned {
-                        if acted.get(l) {
-                            io.locals[j].rotation = rotation.get(l);
-                        }
-                    }
-                    io.models[j] = model_f.get(l);
-                }
-                above = model;
-            }
-        }
-    }
-
     #[inline(never)]
     fn update_baseline(&self, rig: &VrmRig, io: &mut SpringIo<'_>) {
         self.update_lanes::<F>(rig, io)
@@ -503,6 +374,7 @@ impl SpringLanes {
     fn update_lanes<T: Lane>(&self, rig: &VrmRig, io: &mut SpringIo<'_>) {
         let comp = Trs::<T>::of(&Trs::splat(&io.component));
         let dt = T::splat(io.dt);
+        let (carry_motion, carry_force) = (T::splat(io.carry.0), T::splat(io.carry.1));
         let exact = io.mode == VrmMode::Fixed;
         let three_vrm = io.mode == VrmMode::ThreeVrm;
         io.place_in_lanes();
@@ -537,9 +409,9 @@ impl SpringLanes {
                     None => (current_stored, prev_stored),
                 };
                 let rest_dir = parent_world.r.mul_vec3(V3::of(row.rest_bone));
-                let inertia = (current - prev) * T::of(row.keep);
-                let stiffness = rest_dir * (T::of(row.stiffness) * dt);
-                let external = V3::<T>::of(row.gravity) * dt;
+                let inertia = (current - prev) * T::of(row.keep) * carry_motion;
+                let stiffness = rest_dir * (T::of(row.stiffness) * dt) * carry_force;
+                let external = V3::<T>::of(row.gravity) * dt * carry_force;
                 let mut length = T::of(length);
                 if three_vrm {
                     let mut stale = V3::splat(Vec3::ZERO);
