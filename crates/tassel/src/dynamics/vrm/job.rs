@@ -25,7 +25,6 @@ pub struct VrmState {
     /// three-vrm mode: each link's tail node (world) at the end of the previous frame.
     stale_tail: Vec<Vec3>,
     rotation: Vec<Quat>,
-    rotation_before: Vec<Quat>,
     /// Fixed mode's output step: the state it starts from, put back after it.
     kept_current: Vec<Vec3>,
     kept_prev: Vec<Vec3>,
@@ -64,7 +63,6 @@ impl VrmState {
             length: vec![0.0; l],
             stale_tail: vec![Vec3::ZERO; l],
             rotation: vec![Quat::IDENTITY; l],
-            rotation_before: vec![Quat::IDENTITY; l],
             kept_current: vec![Vec3::ZERO; l],
             kept_prev: vec![Vec3::ZERO; l],
             kept_rotation: vec![Quat::IDENTITY; l],
@@ -307,7 +305,6 @@ impl VrmJob<'_> {
                             skeleton, rig, state, &component, dt, opts.mode, locals, models,
                         );
                     }
-                    state.rotation_before.copy_from_slice(&state.rotation);
                 }
                 VrmMode::Fixed => {
                     on_frame = run_fixed(skeleton, rig, state, dt, locals, models, models_given)
@@ -419,7 +416,6 @@ fn reset(
         state.current_tail[i] = stored;
         state.prev_tail[i] = stored;
         state.rotation[i] = l.rest_local.rotation;
-        state.rotation_before[i] = l.rest_local.rotation;
     }
     record_tails(rig, state, component, models);
     state.accumulator = 0.0;
@@ -707,7 +703,6 @@ fn run_fixed(
             }
         }
         place_colliders(rig, state, &comp, &step_models);
-        state.rotation_before.copy_from_slice(&state.rotation);
         update(
             sk,
             rig,

@@ -657,7 +657,6 @@ impl Ctx<'_> {
                     carry: (T::splat(1.0), T::splat(1.0)),
                 };
                 self.place_colliders(&poses, placed);
-                self.shift_rotations(pack, active);
                 let active = <T::M as Mask>::of(active);
                 self.update(pack, &mut poses, placed, VrmMode::Fixed, active);
                 continue;
@@ -688,7 +687,6 @@ impl Ctx<'_> {
                 carry: (T::splat(1.0), T::splat(1.0)),
             };
             self.place_colliders(&poses, placed);
-            self.shift_rotations(pack, active);
             let active = <T::M as Mask>::of(active);
             self.update(pack, &mut poses, placed, VrmMode::Fixed, active);
         }
@@ -698,19 +696,6 @@ impl Ctx<'_> {
         M::from_bools(std::array::from_fn(|l| {
             clocks[l].is_some_and(|c| c.on_frame())
         }))
-    }
-
-    /// Fixed mode, before a step of the lanes in `active`: each rotation becomes the one a
-    /// step before.
-    #[inline(always)]
-    fn shift_rotations(&self, pack: &mut Pack, active: M) {
-        if active == M::ALL {
-            pack.rotation_before.copy_from_slice(&pack.rotation);
-            return;
-        }
-        for i in 0..pack.rotation.len() {
-            pack.rotation_before[i] = Q::select(active, pack.rotation[i], pack.rotation_before[i]);
-        }
     }
 
     /// Fixed mode's output: the last step's rotations in the lanes `on_frame` (whose last
@@ -808,7 +793,6 @@ impl Ctx<'_> {
             pack.current_tail[i] = V3::select(lanes, stored, pack.current_tail[i]);
             pack.prev_tail[i] = V3::select(lanes, stored, pack.prev_tail[i]);
             pack.rotation[i] = Q::select(lanes, rest, pack.rotation[i]);
-            pack.rotation_before[i] = Q::select(lanes, rest, pack.rotation_before[i]);
             bad = bad.or(stored.finite().not());
         }
         bad

@@ -174,8 +174,6 @@ pub(crate) struct Pack {
     pub(crate) length: Vec<F>,
     pub(crate) stale_tail: Vec<V3>,
     pub(crate) rotation: Vec<Q>,
-    /// Fixed mode: the rotations one step before `rotation` (unused in the other modes).
-    pub(crate) rotation_before: Vec<Q>,
     /// The rotations the last frame wrote (fixed mode: the last step's, or an output
     /// step's).
     pub(crate) out_rotation: Vec<Q>,
@@ -203,7 +201,6 @@ impl Pack {
             length: vec![F::splat(0.0); links],
             stale_tail: vec![zero; links],
             rotation: vec![id; links],
-            rotation_before: vec![id; links],
             out_rotation: vec![id; links],
             prev_locals: vec![Trs::splat(&Transform::IDENTITY); slots],
             paths: vec![CharacterPath::default(); LANES],
@@ -224,7 +221,6 @@ pub(crate) struct LaneState {
     pub(crate) length: Vec<f32>,
     pub(crate) stale_tail: Vec<Vec3>,
     pub(crate) rotation: Vec<Quat>,
-    pub(crate) rotation_before: Vec<Quat>,
     pub(crate) out_rotation: Vec<Quat>,
     pub(crate) prev_locals: Vec<Transform>,
     pub(crate) path: CharacterPath,
@@ -242,7 +238,6 @@ impl Pack {
             length: self.length.iter().map(|v| v.get(l)).collect(),
             stale_tail: self.stale_tail.iter().map(|v| v.get(l)).collect(),
             rotation: self.rotation.iter().map(|q| q.get(l)).collect(),
-            rotation_before: self.rotation_before.iter().map(|q| q.get(l)).collect(),
             out_rotation: self.out_rotation.iter().map(|q| q.get(l)).collect(),
             prev_locals: self.prev_locals.iter().map(|t| t.get(l)).collect(),
             path: self.paths[l],
@@ -267,9 +262,6 @@ impl Pack {
             d.set(l, *v);
         }
         for (d, q) in self.rotation.iter_mut().zip(&s.rotation) {
-            d.set(l, *q);
-        }
-        for (d, q) in self.rotation_before.iter_mut().zip(&s.rotation_before) {
             d.set(l, *q);
         }
         for (d, q) in self.out_rotation.iter_mut().zip(&s.out_rotation) {
