@@ -357,8 +357,7 @@ impl Ctx<'_> {
                     models,
                     carry: (T::splat(1.0), T::splat(1.0)),
                 };
-                self.place_colliders(&poses, placed);
-                self.update(pack, &mut poses, placed, mode, <T::M as Mask>::ALL);
+                self.step_on(pack, &mut poses, placed, mode, M::ALL);
             }
         }
         // Guard: a non-finite state starts again from the pose.
@@ -393,6 +392,20 @@ impl Ctx<'_> {
         }
         pack.prev_component = comp;
         pack.needs_reset = [false; LANES];
+    }
+
+    /// One update of the lanes in `active` on `poses`, its colliders placed from them.
+    #[inline(always)]
+    fn step_on<T: Lane>(
+        &self,
+        pack: &mut Pack,
+        poses: &mut Poses<T>,
+        placed: &mut [Placed],
+        mode: VrmMode,
+        active: M,
+    ) {
+        self.place_colliders(poses, placed);
+        self.update(pack, poses, placed, mode, <T::M as Mask>::of(active));
     }
 
     #[inline(always)]
@@ -656,9 +669,7 @@ impl Ctx<'_> {
                     models,
                     carry: (T::splat(1.0), T::splat(1.0)),
                 };
-                self.place_colliders(&poses, placed);
-                let active = <T::M as Mask>::of(active);
-                self.update(pack, &mut poses, placed, VrmMode::Fixed, active);
+                self.step_on(pack, &mut poses, placed, VrmMode::Fixed, active);
                 continue;
             }
             if frame_pose {
@@ -686,9 +697,7 @@ impl Ctx<'_> {
                 models: step_models,
                 carry: (T::splat(1.0), T::splat(1.0)),
             };
-            self.place_colliders(&poses, placed);
-            let active = <T::M as Mask>::of(active);
-            self.update(pack, &mut poses, placed, VrmMode::Fixed, active);
+            self.step_on(pack, &mut poses, placed, VrmMode::Fixed, active);
         }
         if !self.rig.constraints.list.is_empty() {
             return M::NONE;
@@ -752,9 +761,7 @@ impl Ctx<'_> {
             models: step_models,
             carry: (a, a),
         };
-        self.place_colliders(&poses, placed);
-        let active = <T::M as Mask>::of(pass);
-        self.update(pack, &mut poses, placed, VrmMode::Fixed, active);
+        self.step_on(pack, &mut poses, placed, VrmMode::Fixed, pass);
         pack.out_rotation.copy_from_slice(&pack.rotation);
         std::mem::swap(&mut pack.current_tail, &mut s.kept_current);
         std::mem::swap(&mut pack.prev_tail, &mut s.kept_prev);
