@@ -1,12 +1,26 @@
-// `npm run bench` (or `node bench/bench.mjs [FRAMES] [RUNS] [COUNTS]`, COUNTS like 1,100): three-vrm's spring update
-// against Tassel's in Node, side by side in this process (see core.mjs).
+// `npm run bench --prefix web [-- FILE]` (or `node bench/bench.mjs [FILE] [FRAMES] [RUNS]
+// [COUNTS]`, COUNTS like 1,100): three-vrm's spring update against Tassel's in Node, side by
+// side in this process (see core.mjs), on the bench rig or on FILE (a .vrm, or a glTF with
+// VRMC_springBone).
+import fs from 'node:fs';
 import { TasselSpringBoneManager, TasselCrowd } from '../dist/index.js';
 import { loadGltfBytes, THREE } from '../test/gltf.mjs';
 import '../test/load.mjs';
 import { runBench } from './core.mjs';
 
-const frames = Number(process.argv[2] ?? 200);
-const runs = Number(process.argv[3] ?? 7);
-const counts = (process.argv[4] ?? '1,100').split(',').map(Number);
-console.log(`Node ${process.version}, three r${THREE.REVISION}`);
-await runBench({ counts, frames, runs, loadGltfBytes, TasselSpringBoneManager, TasselCrowd, THREE });
+const args = process.argv.slice(2);
+const file = args.length && !/^[0-9,]+$/.test(args[0]) ? args.shift() : null;
+const frames = Number(args[0] ?? 200);
+const runs = Number(args[1] ?? 7);
+const counts = (args[2] ?? '1,100').split(',').map(Number);
+let bytes;
+if (file) {
+  try {
+    bytes = new Uint8Array(fs.readFileSync(file));
+  } catch (e) {
+    console.error(`${file}: ${e.message}`);
+    process.exit(1);
+  }
+}
+console.log(`Node ${process.version}, three r${THREE.REVISION}${file ? `, ${file}` : ', the bench rig'}`);
+await runBench({ counts, frames, runs, bytes, loadGltfBytes, TasselSpringBoneManager, TasselCrowd, THREE });

@@ -1,6 +1,7 @@
 // The side-by-side benchmark of three-vrm's spring update and Tassel's (WebAssembly), in
 // one JavaScript process (Node: bench.mjs; Chromium: index.html): N characters of the
-// 16 x 8-joint rig with 8 colliders (rig.mjs) swaying on their roots; per frame, every
+// 16 x 8-joint rig with 8 colliders (rig.mjs), or of the user's file (`ctx.bytes`, Node),
+// swaying on their roots; per frame, every
 // character's manager.update(1/60), or one TasselCrowd.update(1/60) for all — Tassel's
 // including the transfer of transforms from and to the three.js objects. Runs are
 // interleaved (three-vrm, Tassel three-vrm mode, Tassel fixed, the crowd in both, again...)
@@ -8,7 +9,7 @@
 // simulated joint in one update).
 import { CHAINS, JOINTS_PER_CHAIN, springRigGlb } from './rig.mjs';
 
-const JOINTS = CHAINS * JOINTS_PER_CHAIN;
+const RIG_JOINTS = CHAINS * JOINTS_PER_CHAIN;
 
 // What is measured: three-vrm's manager per character; Tassel's manager per character
 // (one WebAssembly call each); Tassel's crowd (one call a frame for all characters); the
@@ -37,7 +38,7 @@ function stepAlone(crowd, dt) {
 
 async function characters(kind, n, ctx) {
   const { mode, crowd: inCrowd, options = {}, stepAlone: alone = false } = KINDS[kind];
-  const bytes = springRigGlb();
+  const bytes = ctx.bytes ?? springRigGlb();
   const crowd = inCrowd ? await ctx.TasselCrowd.fromBytes(bytes, { mode, ...options }) : null;
   const chars = [];
   for (let i = 0; i < n; i++) {
@@ -81,6 +82,13 @@ function median(v) {
 export async function runBench({ counts = [1, 100], frames = 200, runs = 7, log = console.log, ...ctx }) {
   const kinds = Object.keys(KINDS);
   const results = [];
+  // Per joint: the spring joints three-vrm's manager steps (the rig's 128 by construction).
+  let JOINTS = RIG_JOINTS;
+  if (ctx.bytes) {
+    const { manager } = await ctx.loadGltfBytes(ctx.bytes);
+    JOINTS = manager?.joints?.size ?? 0;
+    if (!JOINTS) throw new Error('the file has no VRM spring joints');
+  }
   for (const n of counts) {
     const sets = {};
     for (const k of kinds) sets[k] = await characters(k, n, ctx);
