@@ -12,8 +12,8 @@
 //!   (toward X, `asin(x)`) within `±yaw`.
 //!
 //! The solver applies the limit where the draft recommends: right after the inertia step
-//! (with the bone length) and after each collider push; in fixed mode also on the
-//! interpolated output pose (`dynamics/vrm/job.rs`). A direction already inside its limit
+//! (with the bone length) and after each collider push; in fixed mode also after the
+//! exact settling of a contact (`dynamics/vrm/job.rs`). A direction already inside its limit
 //! is left as it is, bit for bit (the draft's code recomputes it, which changes only the
 //! last bits). The draft's degenerate cases are resolved as follows: a direction exactly
 //! opposite the cone's axis goes to the cone's +Z edge; a direction along the hinge's axis

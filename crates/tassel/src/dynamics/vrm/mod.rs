@@ -10,7 +10,8 @@
 //! - [`VrmMode::Spec`] runs the update once per frame exactly as the specification and
 //!   UniVRM do; [`VrmMode::ThreeVrm`] as three-vrm 3.5.5 does in a web app (the bone
 //!   length re-measured against last frame's tail); [`VrmMode::Fixed`] runs it at a fixed
-//!   rate with interpolated output, so that the look does not change with the frame rate.
+//!   rate (its output the step that ends on the frame, else an output step carrying the
+//!   last step to the frame's time), so that the look does not change with the frame rate.
 //!
 //! ```
 //! use tassel::dynamics::vrm::*;

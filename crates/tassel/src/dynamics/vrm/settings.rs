@@ -337,9 +337,11 @@ pub enum VrmMode {
     /// [`VrmMode::ThreeVrm`]); the look depends on the frame rate. Ask for it by name for
     /// parity with the specification.
     Spec,
-    /// The same update at a fixed internal rate, inputs interpolated within the frame and
-    /// output interpolated between the last two steps: the look does not depend on the
-    /// frame rate. The default.
+    /// The same update at a fixed internal rate, inputs interpolated within the frame; the
+    /// output is the step that ends on the frame, else an output step (one update of the
+    /// share of a step not yet stepped, on the frame's pose and colliders, not kept): the
+    /// look does not depend on the frame rate, and the output is not a step late. The
+    /// default.
     #[default]
     Fixed,
     /// three-vrm 3.5.5 as a web app runs it (`vrm.update(dt)`, then the render updates the
