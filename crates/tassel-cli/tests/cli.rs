@@ -591,19 +591,15 @@ fn bench_of_a_users_file() {
     let Some(vrm) = testdata("vrm/smoke_spring.vrm") else {
         return;
     };
+    // `tassel bench FILE ARGS…`: whether it succeeded, its stdout and its stderr.
+    let bench = |file: &std::path::Path, args: &[&str]| {
+        let out = tassel().arg("bench").arg(file).args(args).output().unwrap();
+        let text = |b: &[u8]| String::from_utf8_lossy(b).to_string();
+        (out.status.success(), text(&out.stdout), text(&out.stderr))
+    };
     for mode in ["spec", "fixed", "three-vrm"] {
-        let out = tassel()
-            .arg("bench")
-            .arg(&vrm)
-            .args(["--vrm", mode, "--frames", "20", "--runs", "1"])
-            .output()
-            .unwrap();
-        let stdout = String::from_utf8_lossy(&out.stdout);
-        assert!(
-            out.status.success(),
-            "{mode}: {}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        let (ok, stdout, stderr) = bench(&vrm, &["--vrm", mode, "--frames", "20", "--runs", "1"]);
+        assert!(ok, "{mode}: {stderr}");
         assert!(
             stdout.contains("smoke_spring.vrm (25 nodes; 3 VRM spring joints)"),
             "{stdout}"
@@ -612,16 +608,11 @@ fn bench_of_a_users_file() {
             stdout.contains("3 simulated joints") && stdout.contains(" us)"),
             "{stdout}"
         );
-        let out = tassel()
-            .arg("bench")
-            .arg(&vrm)
-            .args([
-                "--vrm", mode, "--crowd", "20", "--frames", "5", "--runs", "1",
-            ])
-            .output()
-            .unwrap();
-        let stdout = String::from_utf8_lossy(&out.stdout);
-        assert!(out.status.success(), "{mode} crowd");
+        let crowd = [
+            "--vrm", mode, "--crowd", "20", "--frames", "5", "--runs", "1",
+        ];
+        let (ok, stdout, _) = bench(&vrm, &crowd);
+        assert!(ok, "{mode} crowd");
         assert!(
             stdout.lines().next().unwrap().contains("crowd path"),
             "{stdout}"
@@ -635,34 +626,23 @@ fn bench_of_a_users_file() {
     if let Some(fox) = testdata("gltf/Fox.glb") {
         let rig =
             std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/rigs/fox.toml");
-        let out = tassel()
-            .arg("bench")
-            .arg(&fox)
-            .arg("--rig")
-            .arg(&rig)
-            .args(["--crowd", "4", "--frames", "5", "--runs", "1"])
-            .output()
-            .unwrap();
-        let stdout = String::from_utf8_lossy(&out.stdout);
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
+        let rig = rig.to_str().unwrap();
+        let (ok, stdout, stderr) = bench(
+            &fox,
+            &["--rig", rig, "--crowd", "4", "--frames", "5", "--runs", "1"],
         );
+        assert!(ok, "{stderr}");
         assert!(
             stdout.contains("one CharacterSim per character"),
             "{stdout}"
         );
-        let out = tassel().arg("bench").arg(&fox).output().unwrap();
-        assert!(!out.status.success());
-        assert!(String::from_utf8_lossy(&out.stderr).contains("--rig"));
+        let (ok, _, stderr) = bench(&fox, &[]);
+        assert!(!ok);
+        assert!(stderr.contains("--rig"));
     }
-    let out = tassel()
-        .args(["bench", "no-such-file.vrm"])
-        .output()
-        .unwrap();
-    assert!(!out.status.success());
-    assert!(String::from_utf8_lossy(&out.stderr).contains("no-such-file.vrm"));
+    let (ok, _, stderr) = bench(std::path::Path::new("no-such-file.vrm"), &[]);
+    assert!(!ok);
+    assert!(stderr.contains("no-such-file.vrm"));
 }
 
 /// World positions of a sample's tails.

@@ -30,8 +30,8 @@ pub struct VrmState {
     kept_prev: Vec<Vec3>,
     kept_rotation: Vec<Quat>,
     /// The share of a step an update carries the motion (inertia) and the forces
-    /// (stiffness, gravity) by: (1, 1) for a step; fixed mode's output step (`a` of a step)
-    /// `(a, a(1 + a)/2)`, as a Verlet step of `a·h` would.
+    /// (stiffness, gravity) by: (1, 1) for a step, (`a`, `a`) for fixed mode's output step
+    /// of `a` of a step (the spec's stiffness and gravity terms are displacements per step).
     carry: (f32, f32),
     placed: Vec<PlacedVrmCollider>,
     // Fixed mode: last frame's animated input and the scratch pose of a step.
@@ -655,8 +655,7 @@ fn refresh(sk: &Skeleton, locals: &[Transform], models: &mut [Transform], from: 
 }
 
 /// Fixed mode: whole steps of `1/step_rate` up to now, each with the animated pose and the
-/// character transform interpolated to its time; remembers the last three step rotations.
-/// Time left over within [`ON_FRAME`](crate::dynamics::path::ON_FRAME) of a step is
+/// character transform interpolated to its time. Time left over within [`ON_FRAME`](crate::dynamics::path::ON_FRAME) of a step is
 /// dropped, and a last step that then ends on the frame takes the frame's own pose
 /// (`locals`, and `models` when `models_given` says it is their model pose): returns
 /// whether it did, so that its rotations are the frame's output as they are.

@@ -330,7 +330,7 @@ impl Ctx<'_> {
         }
         // The animated model pose (as the single-character frame computes it); where the
         // specification's update runs (fixed mode: on every frame), only of the slots it
-        // reads before writing them: fixed mode's output pose and pass also compose the
+        // reads before writing them: fixed mode's steps and output step also compose the
         // slots the springs move before reading them.
         let updates = (fixed || self.dt > 0.0) && reset != M::ALL;
         for k in 0..plan.joints.len() {
@@ -660,9 +660,9 @@ impl Ctx<'_> {
             }
             let frame_pose = w.iter().all(|&w| w >= 1.0);
             if frame_pose && active == M::ALL && self.rig.constraints.list.is_empty() {
-                // Every lane's last step ends on the frame (and none will need the output
-                // pass, whose colliders are placed from the animated models): it steps on
-                // the frame's pose itself.
+                // Every lane's last step ends on the frame: it steps on the frame's pose
+                // itself. (Only a lane the guard resets runs an output step after it, on
+                // the reset's models; the slots this update writes are not read again.)
                 let mut poses = Poses {
                     comp: Trs::<T>::of(&comp),
                     locals,
