@@ -1,6 +1,6 @@
 //! `tassel demo`: the embedded character through the scripted run in its level.
 
-use crate::demo_look::{body, group_color, level_color};
+use crate::demo_look::level_color;
 use crate::output::write_atomic;
 use glam::{Quat, Vec3};
 use std::path::PathBuf;
@@ -10,6 +10,7 @@ use tassel::builtin::{self, DemoScript};
 use tassel::collide::Shape;
 use tassel::dynamics::cloth::ConstraintKind;
 use tassel::CharacterSim;
+use tassel_gltf::{builtin_body as body, group_color};
 use tassel_gltf::{export_glb, BakedClip, BakedTrack, BoneMesh, ExportSource, LevelPart, Material};
 use tassel_render::{draw_strip, side_outlines, Band, Chart, ChartSeries, Panel};
 
@@ -416,6 +417,11 @@ pub fn run(a: Args) -> Result<(), String> {
     write_atomic(&glb_path, &glb)?;
     write_atomic(&png_path, &png)?;
     write_atomic(&rig_path, rig_text.as_bytes())?;
+    // The same character as a VRM 1.0 avatar (its strands as VRM spring bones, no
+    // animation): what the web example and `tassel bench` run when given no file.
+    let vrm_path = a.out.join("demo.vrm");
+    let vrm = tassel_gltf::builtin_avatar().map_err(|e| e.to_string())?;
+    write_atomic(&vrm_path, &vrm)?;
     let simulated = sim.chains().point_count() - sim.chains().chain_count()
         + sim.cloths().simulated_joints().count()
         + sim.ropes().simulated_joints().count();
@@ -456,12 +462,14 @@ pub fn run(a: Args) -> Result<(), String> {
     let [(on, _), (off, _)] = tassel::builtin::level::GUST_EVENTS;
     say!("  gust: {on:.1}–{off:.1} s on the platform (an external force, switched by events)");
     say!(
-        "  wrote {} ({} bytes), {} ({} bytes) and its rig, {}",
+        "  wrote {} ({} bytes), {} ({} bytes) and its rig, {}; the character as a VRM 1.0 avatar, {} ({} bytes)",
         glb_path.display(),
         glb.len(),
         png_path.display(),
         png.len(),
-        rig_path.display()
+        rig_path.display(),
+        vrm_path.display(),
+        vrm.len()
     );
     Ok(())
 }

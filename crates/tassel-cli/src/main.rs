@@ -45,7 +45,9 @@ enum Command {
     /// closes, ride a moving, turning platform) with its hair, tail, skirt, charm and
     /// springs; write demo.glb (the level, the character's skinned body and the baked
     /// animation, door and platform included) and demo.png (eight titled side views in the
-    /// level over a chart of the tips' distance from their animated place).
+    /// level over a chart of the tips' distance from their animated place), demo.rig.toml
+    /// (the character's rig) and demo.vrm (the character as a VRM 1.0 avatar: skinned
+    /// body, humanoid, its strands as VRM spring bones).
     Demo(demo::Args),
     /// A scripted, machine-readable run: joint positions per frame as JSON.
     Simulate(simulate::Args),

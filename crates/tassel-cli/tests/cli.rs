@@ -54,6 +54,10 @@ fn demo_writes_valid_files_and_is_deterministic() {
     if let Some(report) = validate(&a.join("demo.glb")) {
         assert!(report.contains("\"errors\":0"), "{report}");
     }
+    // The character as a VRM 1.0 avatar beside it: the importer reads its springs.
+    let vrm = tassel_gltf::load(&a.join("demo.vrm")).unwrap();
+    let springs = &vrm.vrm.as_ref().expect("demo.vrm has spring bones").springs;
+    assert_eq!(springs.springs.len(), 13);
     // The baked clip has one key per frame: 18.5 s at 60 Hz = 1 111 keys.
     let json_len = u32::from_le_bytes(glb[12..16].try_into().unwrap()) as usize;
     let doc: serde_json::Value = serde_json::from_slice(&glb[20..20 + json_len]).unwrap();

@@ -9,7 +9,8 @@
 //!   baked keys can go into an input animation in place ([`BakedClip::merge_into`]);
 //!   a document built from a skeleton can get a controller level as meshes
 //!   ([`ExportSource::add_level`]) and a skinned body of tubes and sheets
-//!   ([`ExportSource::add_body`]).
+//!   ([`ExportSource::add_body`]); a document can be made a VRM 1.0 avatar
+//!   ([`ExportSource::add_vrm`]), and the built-in character is one ([`builtin_avatar`]).
 //! - [`bake_clip`]: play a clip through a [`tassel::CharacterSim`] and key the bones it
 //!   simulates.
 //!
@@ -33,7 +34,9 @@
 pub use tassel;
 
 mod accessor;
+mod avatar;
 mod bake;
+mod builtin_look;
 mod error;
 mod export;
 mod import;
@@ -42,14 +45,18 @@ mod scene;
 mod tessellate;
 mod uri;
 mod vrm;
+mod vrm_export;
 mod vrm_limit;
 
+pub use avatar::builtin_avatar;
 pub use bake::{
     bake_clip, key_times, play, BakeOptions, BakeSource, PlayedFrame, Sway, MAX_BAKE_KEYS,
 };
+pub use builtin_look::{builtin_body, group_color};
 pub use error::{GltfError, PlayError};
 pub use export::{export_glb, BakedClip, BakedTrack, BoneMesh, ExportSource};
 pub use import::{load, load_slice, Model, SkinInfo, MAX_FILE_BYTES};
 pub use mesh::MeshInstance;
 pub use scene::{Body, LevelPart, Limb, Material, Sheet};
 pub use vrm::{read_spring_bones, VrmInfo, VrmVersion, VRM0_TAIL_LENGTH};
+pub use vrm_export::{VrmAvatar, VRM1_REQUIRED_BONES};

@@ -29,6 +29,9 @@ pub struct Character {
 #[path = "builtin_level.rs"]
 pub mod level;
 
+#[path = "builtin_avatar.rs"]
+pub mod avatar;
+
 /// Index of each clip in [`Character::clips`].
 pub mod clip {
     /// Breathing in place, 2 s loop.
@@ -505,32 +508,15 @@ pub fn bench_vrm(
     joints: usize,
     colliders: usize,
 ) -> (Skeleton, crate::dynamics::vrm::VrmSpringBones) {
-    use crate::dynamics::vrm::{
-        VrmCollider, VrmColliderGroup, VrmJoint, VrmShape, VrmSpring, VrmSpringBones, VrmTail,
-    };
+    use crate::dynamics::vrm::{VrmColliderGroup, VrmJoint, VrmSpring, VrmSpringBones, VrmTail};
     let (sk, rig) = bench_character(chains, joints, colliders);
-    let mut b = VrmSpringBones::default();
-    for c in &rig.colliders {
-        let joint = sk.find(&c.bone).expect("bench collider bone");
-        let shape = match c.shape {
-            Shape::Sphere { radius, inside } => VrmShape::Sphere {
-                offset: c.offset,
-                radius,
-                inside,
-            },
-            Shape::Capsule { radius, length } => {
-                let axis = c.rotation * Vec3::Y * (0.5 * length);
-                VrmShape::Capsule {
-                    offset: c.offset - axis,
-                    tail: c.offset + axis,
-                    radius,
-                    inside: false,
-                }
-            }
-            _ => continue,
-        };
-        b.colliders.push(VrmCollider { joint, shape });
-    }
+    let mut b = VrmSpringBones {
+        colliders: avatar::vrm_colliders(&sk, &rig.colliders)
+            .into_iter()
+            .map(|(_, c)| c)
+            .collect(),
+        ..Default::default()
+    };
     b.collider_groups.push(VrmColliderGroup {
         name: "all".into(),
         colliders: (0..b.colliders.len()).collect(),
