@@ -49,6 +49,24 @@ async function instantiate(source) {
   return new Tassel(instance.exports);
 }
 
+/** Tassel's built-in character as a VRM 1.0 file (a Uint8Array of GLB bytes: a skinned
+ *  body, 82 bones, its hair, tail, skirt and charm as 13 VRM springs of 44 joints over 6
+ *  colliders), made by the module: an avatar to try, and to redistribute, without a file
+ *  of one's own. Load it as any .vrm (`GLTFLoader.parse(bytes.buffer, ...)`). */
+export async function builtinAvatar(source) {
+  const tassel = await loadTassel(source);
+  const x = tassel.x;
+  const len = x.tassel_builtin_avatar(0, 0);
+  if (!len) throw tassel.error('the built-in avatar was not made');
+  const buf = tassel.copyIn(new Uint8Array(len));
+  try {
+    if (x.tassel_builtin_avatar(buf[0], len) !== len) throw tassel.error('the built-in avatar was not made');
+    return new Uint8Array(tassel.memory.buffer, buf[0], len).slice();
+  } finally {
+    tassel.free(buf);
+  }
+}
+
 /** The module's exports, with strings and buffers across its memory. */
 class Tassel {
   constructor(exports) {

@@ -1,7 +1,7 @@
 // The example as the README gives it: `npm run example --prefix web`, run from the
 // repository's root exactly as written, serves the page; headless Chromium opens the URL
-// it prints and waits for the page to be ready: no page error, the WebAssembly manager
-// loaded, and (with ../shared beside the clone) a test avatar stepping.
+// it prints and waits for the page to be ready: no page error, the built-in avatar (made by
+// the WebAssembly module) stepping, and (with ../shared beside the clone) a test file too.
 import { chromium } from 'playwright-core';
 import { spawn } from 'node:child_process';
 import fs from 'node:fs';
@@ -46,10 +46,18 @@ try {
     await page.waitForTimeout(1000);
     const text = await page.evaluate(() => document.getElementById('times').textContent);
     console.log(`example page: ${text}`);
-    const haveTestdata = fs.existsSync(path.join(root, '../shared/testdata/vrm'));
-    if (haveTestdata && !/spring bones · update: Tassel [0-9.]+ ms/.test(text)) {
-      console.log('FAIL example: no avatar stepping on the page');
+    // The built-in avatar first, made by the module: no file needed. Its 44 spring
+    // joints are counted from the character (13 strands; see builtin_avatar.rs).
+    if (!/^Tassel's character: 44 spring bones · update: Tassel [0-9.]+ ms/.test(text)) {
+      console.log('FAIL example: the built-in avatar is not stepping on the page');
       failures++;
+    }
+    // With ../shared beside the clone, a test file from the list steps too.
+    if (fs.existsSync(path.join(root, '../shared/testdata/vrm'))) {
+      await page.selectOption('#file', { label: 'smoke_spring.vrm' });
+      await page.waitForFunction(() => /^smoke_spring\.vrm: \d+ spring bones · update: Tassel [0-9.]+ ms/
+        .test(document.getElementById('times').textContent), null, { timeout: 30_000 });
+      console.log(`example page: ${await page.evaluate(() => document.getElementById('times').textContent)}`);
     }
   } finally {
     await browser.close();

@@ -186,6 +186,18 @@ const char *tassel_last_error(void);
 // The library's version ("0.1.0"), static.
 const char *tassel_version(void);
 
+// The built-in character as a VRM 1.0 avatar file (GLB bytes: 82 joint nodes, a skinned
+// body, a humanoid, its hair, tail, skirt and charm as 13 VRM springs of 44 joints over 6
+// colliders; made in code, free to redistribute): a character to try without a file of
+// one's own. Returns the file's length in bytes and, when `capacity` is at least that,
+// writes the file to `out`; call with NULL and 0 to learn the length. 0 on an error (see
+// `tassel_last_error`). The same bytes on every call.
+//
+// # Safety
+// `out` is NULL or points to `capacity` writable bytes.
+size_t tassel_builtin_avatar(uint8_t *out,
+                             size_t capacity);
+
 // `size` bytes of the library's memory, 16-byte aligned (NULL if `size` is 0 or too
 // large): for hosts that cannot hand the library their own memory, such as JavaScript
 // with the WebAssembly module. Free with `tassel_free(p, size)`.

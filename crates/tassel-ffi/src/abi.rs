@@ -500,6 +500,30 @@ pub extern "C" fn tassel_version() -> *const c_char {
     VERSION.as_ptr()
 }
 
+/// The built-in character as a VRM 1.0 avatar file (GLB bytes: 82 joint nodes, a skinned
+/// body, a humanoid, its hair, tail, skirt and charm as 13 VRM springs of 44 joints over 6
+/// colliders; made in code, free to redistribute): a character to try without a file of
+/// one's own. Returns the file's length in bytes and, when `capacity` is at least that,
+/// writes the file to `out`; call with NULL and 0 to learn the length. 0 on an error (see
+/// `tassel_last_error`). The same bytes on every call.
+///
+/// # Safety
+/// `out` is NULL or points to `capacity` writable bytes.
+#[no_mangle]
+pub unsafe extern "C" fn tassel_builtin_avatar(out: *mut u8, capacity: usize) -> usize {
+    guard("tassel_builtin_avatar", 0, || {
+        let bytes = tassel_gltf::builtin_avatar().map_err(|e| e.to_string())?;
+        if capacity >= bytes.len() {
+            if out.is_null() {
+                return Err("out is NULL".into());
+            }
+            // SAFETY: non-NULL, `capacity` ≥ len writable bytes by the caller's promise.
+            unsafe { std::slice::from_raw_parts_mut(out, bytes.len()) }.copy_from_slice(&bytes);
+        }
+        Ok(bytes.len())
+    })
+}
+
 /// `size` bytes of the library's memory, 16-byte aligned (NULL if `size` is 0 or too
 /// large): for hosts that cannot hand the library their own memory, such as JavaScript
 /// with the WebAssembly module. Free with `tassel_free(p, size)`.

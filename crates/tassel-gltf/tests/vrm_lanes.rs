@@ -111,3 +111,73 @@ fn lanes_give_the_scalar_bits_on_every_vrm_file() {
         assert!(with_lanes >= 4, "only {with_lanes} files run in lanes");
     }
 }
+
+/// The built-in avatar's springs test different colliders: the ponytail the head and torso
+/// (colliders 0, 1), the locks the head (0), the charm the left thigh (2): ascending lists,
+/// so these four columns share one lane group with a collider mask per lane. The tail and
+/// the skirt's eight columns test the legs in the order thigh_l, thigh_r, shin_l, shin_r
+/// (2, 4, 3, 5: not ascending), so they share a group of their own by their one list.
+/// Still the scalar bits, and the colliders do act (the same run without them turns the
+/// joints elsewhere).
+#[test]
+fn springs_with_different_colliders_share_lanes_and_keep_the_scalar_bits() {
+    let model =
+        tassel_gltf::load_slice(&tassel_gltf::builtin_avatar().unwrap(), None, "avatar.vrm")
+            .unwrap();
+    let bones = model.vrm.clone().unwrap().springs;
+    let lists: std::collections::BTreeSet<Vec<usize>> = bones
+        .springs
+        .iter()
+        .map(|s| s.collider_groups.clone())
+        .collect();
+    assert!(lists.len() >= 4, "{lists:?}");
+    let sim = CharacterSim::with_vrm(
+        model.skeleton.clone(),
+        &RigSettings::default(),
+        &bones,
+        VrmOptions::default(),
+    )
+    .unwrap();
+    // 13 columns, none below another spring, none with a centre: the two groups above.
+    assert_eq!(sim.vrm().lane_groups(), 2);
+    for mode in [
+        (VrmMode::Spec, 60.0),
+        (VrmMode::ThreeVrm, 60.0),
+        (VrmMode::Fixed, 60.0),
+        (VrmMode::Fixed, 90.0),
+    ] {
+        let turned = compare("avatar", &model.skeleton, &bones, mode);
+        assert!(turned > 0.05, "{mode:?}: the springs never moved");
+    }
+    // The colliders act: without them the joints end up elsewhere.
+    let mut free = bones.clone();
+    for s in &mut free.springs {
+        s.collider_groups.clear();
+    }
+    let run = |b: &VrmSpringBones| {
+        let sk = &model.skeleton;
+        let mut sim = CharacterSim::with_vrm(
+            sk.clone(),
+            &RigSettings::default(),
+            b,
+            VrmOptions::default(),
+        )
+        .unwrap();
+        let swing = sim.vrm().links[0].parent.unwrap();
+        let mut locals = sk.rest().to_vec();
+        let mut out = Vec::new();
+        for f in 0..300 {
+            let t = input(sk, swing, 0, f, &mut locals);
+            out = sim.frame(&locals, t, 1.0 / 60.0).unwrap().locals.clone();
+        }
+        out
+    };
+    let (with, without) = (run(&bones), run(&free));
+    let moved = sim
+        .vrm()
+        .links
+        .iter()
+        .filter(|l| with[l.joint].rotation != without[l.joint].rotation)
+        .count();
+    assert!(moved > 10, "only {moved} joints felt the colliders");
+}

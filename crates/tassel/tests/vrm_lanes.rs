@@ -371,6 +371,51 @@ fn lanes_give_the_scalar_bits_on_the_bench_rig() {
     assert_lanes_match_in_every_mode(&sk, &bones);
 }
 
+/// Springs with different collider lists in one group: on the bench rig of four strands
+/// around four colliders, strands 0 and 2 test them all and strands 1 and 3 none (both
+/// lists ascending: one group, a collider mask per lane). The colliders do reach strands
+/// 1 and 3 when listed (checked first), so lanes that tested colliders their links do not
+/// list would lose the scalar bits.
+#[test]
+fn springs_with_different_colliders_share_a_group_and_keep_the_scalar_bits() {
+    let (sk, all) = builtin::bench_vrm(4, 8, 4);
+    let mut some = all.clone();
+    for (k, s) in some.springs.iter_mut().enumerate() {
+        if k % 2 == 1 {
+            s.collider_groups.clear();
+        }
+    }
+    let rig = VrmRig::new(&sk, &some, VrmOptions::default()).unwrap();
+    assert_eq!(rig.lane_groups(), 1);
+    // Strand 1's last joint with and without the colliders, scalar.
+    let run = |b: &VrmSpringBones| {
+        let mut sim = CharacterSim::with_vrm(
+            sk.clone(),
+            &RigSettings::default(),
+            b,
+            VrmOptions::default(),
+        )
+        .unwrap();
+        sim.set_simd(SimdUse::Scalar);
+        let swing = sim.vrm().links[0].parent.unwrap_or(0);
+        let mut locals = sk.rest().to_vec();
+        let joint = sk.find("c1_7").unwrap();
+        let mut out = Vec::new();
+        for f in 0..600 {
+            let t = motion(&sk, swing, f, &mut locals);
+            out.push(sim.frame(&locals, t, dt_at(f)).unwrap().locals[joint].rotation);
+        }
+        out
+    };
+    let (touched, free) = (run(&all), run(&some));
+    let felt = touched.iter().zip(&free).filter(|(a, b)| a != b).count();
+    assert!(
+        felt > 10,
+        "the colliders reach strand 1 on {felt} frames only"
+    );
+    assert_lanes_match_in_every_mode(&sk, &some);
+}
+
 /// Rigs the lanes cannot take run the scalar update (and still agree, trivially).
 #[test]
 fn rigs_the_lanes_cannot_take_run_the_scalar_update() {

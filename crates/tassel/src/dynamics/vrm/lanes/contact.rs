@@ -4,7 +4,7 @@
 //! springs side by side ([`super::springs`]).
 
 use crate::dynamics::vrm::{LinkLimit, VrmShape};
-use crate::lanes::{closest_point_on_segment, differs, Lane, Mask, F, LANES, Q, V3};
+use crate::lanes::{closest_point_on_segment, differs, Lane, Mask, F, LANES, M, Q, V3};
 use glam::Vec3;
 
 /// A collider placed in world space, per lane: `a` (centre, capsule head, plane point) and
@@ -187,11 +187,15 @@ pub(crate) fn settle_one<T: Lane>(
 /// The specification's collision (one push per collider and the projection back to
 /// the bone length), then with `exact` the settling of what is left inside. Returns
 /// the tail and the lanes where a collider acted. `colliders` are indices into `shapes`
-/// and `placed` (the link's list); `r` is the tail radius per lane.
+/// and `placed` (the link's list); `r` is the tail radius per lane. With `masks` (one per
+/// collider), collider `k` acts only on the lanes of `masks[k]`: lanes whose links have
+/// different lists, each the in-order sublist of `colliders` its mask picks, get the
+/// scalar bits of their own list.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 pub(crate) fn collide_tail<T: Lane>(
     colliders: &[usize],
+    masks: Option<&[M]>,
     shapes: &[(usize, VrmShape)],
     placed: &[Placed],
     r: T,
@@ -203,10 +207,15 @@ pub(crate) fn collide_tail<T: Lane>(
     limit: Option<(&LinkLimit, Q<T>)>,
 ) -> (V3<T>, T::M) {
     let mut acted = <T::M as Mask>::NONE;
-    for &c in colliders {
+    let only = |k: usize| masks.map(|m| <T::M as Mask>::of(m[k]));
+    for (k, &c) in colliders.iter().enumerate() {
         let shape = &shapes[c].1;
         let pl = Placed::<T>::of(&placed[c]);
         if let Some((dir, dist, hit)) = contact(shape, &pl, tail, r) {
+            let hit = match only(k) {
+                Some(m) => hit.and(m),
+                None => hit,
+            };
             let pushed = position + (tail - dir * dist - position).normalize_or(rest_dir) * length;
             tail = V3::select(hit, pushed, tail);
             acted = acted.or(hit);
@@ -223,13 +232,16 @@ pub(crate) fn collide_tail<T: Lane>(
         let zero = T::splat(0.0);
         for _ in 0..2 {
             let mut changed = <T::M as Mask>::NONE;
-            for &c in colliders {
+            for (k, &c) in colliders.iter().enumerate() {
                 let shape = &shapes[c].1;
                 let pl = Placed::<T>::of(&placed[c]);
                 let Some(before) = penetration(shape, &pl, tail, r) else {
                     continue;
                 };
-                let inside = zero.lt(before);
+                let inside = match only(k) {
+                    Some(m) => zero.lt(before).and(m),
+                    None => zero.lt(before),
+                };
                 if !inside.any() {
                     continue;
                 }

@@ -604,6 +604,7 @@ impl Ctx<'_> {
     ) -> (V3<T>, T::M) {
         collide_tail(
             &self.rig.link_colliders[lp.colliders.clone()],
+            None,
             &self.plan.colliders,
             placed,
             T::splat(lp.hit_radius),

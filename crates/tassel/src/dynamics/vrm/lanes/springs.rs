@@ -9,8 +9,11 @@
 //! its own model (both composed from the links above it), its centre's model and its own
 //! state, and writes its rotation and model. So any order in which every link comes after
 //! the links above it gives the same values. The plan holds the springs as *columns*
-//! (each link's parent is the link before it in its column) and puts up to eight columns
-//! with the same colliders and centre in a *group*; a group's row `d` is the `d`-th link of
+//! (each link's parent is the link before it in its column) and puts up to [`LANES`]
+//! columns with the same centre in a *group*: columns with the same colliders, or columns
+//! whose collider lists are ascending (the group then tests their union in order, each
+//! collider masked to the lanes that list it, which is each lane's own list in its own
+//! order); a group's row `d` is the `d`-th link of
 //! each of its columns. A column that hangs below another column's link (a branching
 //! spring) goes to a later group ([`Group`]s are in order of that depth).
 //!
@@ -32,7 +35,6 @@ use crate::math::{normalize_or, Transform};
 use crate::pose::compose_joints;
 use crate::skeleton::Skeleton;
 use glam::{Quat, Vec3};
-use std::ops::Range;
 
 /// The rig's links as lane rows, compiled once with the rig.
 #[derive(Debug, Clone, PartialEq)]
@@ -56,12 +58,16 @@ pub(crate) struct SpringLanes {
     input: Vec<usize>,
 }
 
-/// Up to [`LANES`] columns with the same colliders and centre.
+/// Up to [`LANES`] columns with the same centre, and the same colliders or colliders
+/// listed in ascending order (each lane then tests its own).
 #[derive(Debug, Clone, PartialEq)]
 struct Group {
     center: Option<usize>,
-    /// The colliders of every link of the group (a range of the rig's `link_colliders`).
-    colliders: Range<usize>,
+    /// The colliders the group's links test, in order: their common list, or the union of
+    /// their ascending lists.
+    colliders: Vec<usize>,
+    /// With a union: per collider, the lanes whose links test it (see [`collide_tail`]).
+    masks: Option<Vec<M>>,
     rows: Vec<Row>,
 }
 
@@ -169,8 +175,17 @@ impl SpringLanes {
             affected[j] = link_at[j].is_some() || sk.parent(j).is_some_and(|p| affected[p]);
         }
         let colliders_of = |i: usize| &rig.link_colliders[links[i].colliders.clone()];
-        let same_group = |a: usize, b: usize| {
+        // A column's links share their colliders and centre.
+        let same_column = |a: usize, b: usize| {
             links[a].center == links[b].center && colliders_of(a) == colliders_of(b)
+        };
+        // Columns whose lists are ascending (no collider twice) share a group whatever
+        // their colliders: each lane tests the union's colliders that are its own, in the
+        // union's order, which is its own list's.
+        let ascending = |i: usize| colliders_of(i).windows(2).all(|w| w[0] < w[1]);
+        let same_group = |a: usize, b: usize| {
+            links[a].center == links[b].center
+                && (colliders_of(a) == colliders_of(b) || (ascending(a) && ascending(b)))
         };
         let mut columns: Vec<Column> = Vec::new();
         let mut column_of = vec![usize::MAX; links.len()];
@@ -182,7 +197,7 @@ impl SpringLanes {
             let level = match link_at[p] {
                 Some(pi) => {
                     let c = column_of[pi];
-                    if columns[c].links.last() == Some(&pi) && same_group(pi, i) {
+                    if columns[c].links.last() == Some(&pi) && same_column(pi, i) {
                         columns[c].links.push(i);
                         column_of[i] = c;
                         continue;
@@ -200,14 +215,19 @@ impl SpringLanes {
                 level,
             });
         }
-        // Shallow levels first; within one, columns with the same colliders and centre
-        // together, longest first (so that a row's lanes in use are a prefix).
+        // Shallow levels first; within one, columns that can share a group together
+        // (the same centre; ascending lists, or else the same list), longest first (so
+        // that a row's lanes in use are a prefix).
         let mut order: Vec<usize> = (0..columns.len()).collect();
+        let key = |c: &Column| {
+            let l = c.links[0];
+            let list: &[usize] = if ascending(l) { &[] } else { colliders_of(l) };
+            (c.level, links[l].center, !ascending(l), list)
+        };
         order.sort_by(|&a, &b| {
             let (ca, cb) = (&columns[a], &columns[b]);
-            let (la, lb) = (ca.links[0], cb.links[0]);
-            (ca.level, links[la].center, colliders_of(la))
-                .cmp(&(cb.level, links[lb].center, colliders_of(lb)))
+            key(ca)
+                .cmp(&key(cb))
                 .then(cb.links.len().cmp(&ca.links.len()))
         });
         let mut groups = Vec::new();
@@ -384,7 +404,6 @@ impl SpringLanes {
                 Some(c) => Some(Trs::<T>::of(&Trs::splat(&(io.component * io.models[c])))),
                 None => None,
             };
-            let colliders = &rig.link_colliders[g.colliders.clone()];
             let mut above = Trs::<T>::of(&Trs::splat(&Transform::IDENTITY));
             for (d, row) in g.rows.iter().enumerate() {
                 let (parent, local) = io.row_pose(row, d, above);
@@ -425,7 +444,8 @@ impl SpringLanes {
                     + (current + inertia + stiffness + external - position).normalize_or(rest_dir)
                         * length;
                 let (next, _) = collide_tail(
-                    colliders,
+                    &g.colliders,
+                    g.masks.as_deref(),
                     &rig.colliders,
                     io.lane_placed,
                     T::of(row.hit_radius),
@@ -476,9 +496,34 @@ impl Group {
                 Row::new(sk, rig, n, link)
             })
             .collect();
+        let list = |c: &Column| &rig.link_colliders[rig.links[c.links[0]].colliders.clone()];
+        let mut colliders = list(columns[0]).to_vec();
+        let mut masks = None;
+        if columns.iter().any(|c| list(c) != list(columns[0])) {
+            // Ascending lists (`SpringLanes::new` grouped only those): their union, and
+            // per collider the lanes whose list has it. Lanes past the columns repeat lane
+            // 0's links (never written back) and take its list.
+            colliders = columns
+                .iter()
+                .flat_map(|c| list(c).iter().copied())
+                .collect();
+            colliders.sort_unstable();
+            colliders.dedup();
+            masks = Some(
+                colliders
+                    .iter()
+                    .map(|k| {
+                        M::from_bools(std::array::from_fn(|l| {
+                            list(columns.get(l).unwrap_or(&columns[0])).contains(k)
+                        }))
+                    })
+                    .collect(),
+            );
+        }
         Group {
             center: head.center,
-            colliders: head.colliders.clone(),
+            colliders,
+            masks,
             rows,
         }
     }
