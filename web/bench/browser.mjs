@@ -1,10 +1,13 @@
-// `node bench/browser.mjs [FRAMES] [RUNS]`: bench/index.html in headless Chromium (Debian's
-// /usr/bin/chromium): three-vrm's spring update against Tassel's, side by side in the page.
+// `node bench/browser.mjs [avatar] [FRAMES] [RUNS]`: bench/index.html in headless Chromium
+// (Debian's /usr/bin/chromium): three-vrm's spring update against Tassel's, side by side in
+// the page, on the bench rig or (`avatar`) Tassel's built-in avatar.
 import { chromium } from 'playwright-core';
 import { start } from '../test/serve.mjs';
 
-const frames = Number(process.argv[2] ?? 400);
-const runs = Number(process.argv[3] ?? 7);
+const args = process.argv.slice(2);
+const avatar = args[0] === 'avatar' ? args.shift() : null;
+const frames = Number(args[0] ?? 400);
+const runs = Number(args[1] ?? 7);
 const server = await start(0);
 const browser = await chromium.launch({
   executablePath: process.env.CHROMIUM ?? '/usr/bin/chromium',
@@ -15,7 +18,7 @@ try {
   const page = await browser.newPage();
   page.on('console', (m) => console.log(m.text()));
   page.on('pageerror', (e) => console.log(`page error: ${e.message}`));
-  await page.goto(`http://127.0.0.1:${server.address().port}/bench/?frames=${frames}&runs=${runs}`);
+  await page.goto(`http://127.0.0.1:${server.address().port}/bench/?frames=${frames}&runs=${runs}${avatar ? '&avatar=1' : ''}`);
   await page.waitForFunction(() => window.tasselBench !== undefined, null, { timeout: 900_000 });
   const { rows, userAgent } = await page.evaluate(() => window.tasselBench);
   console.log(userAgent);

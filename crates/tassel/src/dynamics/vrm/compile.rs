@@ -165,15 +165,15 @@ impl VrmRig {
         self.lanes.as_ref().map_or(0, |l| l.groups())
     }
 
-    /// The lane plan when the job runs it (`simd` not [`crate::lanes::SimdUse::Scalar`])
-    /// and no node constraint runs before it: then the job reads, of the models it is
-    /// given, only those of the plan's input joints (`SpringLanes::compose_input`).
+    /// The lane plan when the job runs it (`SpringLanes::runs_with(simd)`) and no node
+    /// constraint runs before it: then the job reads, of the models it is given, only
+    /// those of the plan's input joints (`SpringLanes::compose_input`).
     pub(crate) fn lanes_for(
         &self,
         simd: crate::lanes::SimdUse,
     ) -> Option<&crate::dynamics::vrm::lanes::springs::SpringLanes> {
-        let runs = simd != crate::lanes::SimdUse::Scalar && self.constraints.list.is_empty();
-        self.lanes.as_ref().filter(|_| runs)
+        let runs = self.constraints.list.is_empty();
+        self.lanes.as_ref().filter(|l| runs && l.runs_with(simd))
     }
 
     /// True when nothing is simulated.

@@ -359,7 +359,7 @@ impl VrmJob<'_> {
 /// The lane plan when this state runs it (the rig allows it and `SimdUse` is not
 /// `Scalar`): the one condition of every lane path of the job.
 fn lane_plan<'a>(rig: &'a VrmRig, state: &VrmState) -> Option<&'a SpringLanes> {
-    rig.lanes.as_ref().filter(|_| state.simd != SimdUse::Scalar)
+    rig.lanes.as_ref().filter(|l| l.runs_with(state.simd))
 }
 
 /// Fixed mode's output step: one update of `a` (0..=1) of a step from the last step's
