@@ -10,10 +10,9 @@
 //! state, and writes its rotation and model. So any order in which every link comes after
 //! the links above it gives the same values. The plan holds the springs as *columns*
 //! (each link's parent is the link before it in its column) and puts up to [`LANES`]
-//! columns with the same centre in a *group*: columns with the same colliders, or columns
-//! whose collider lists are ascending (the group then tests their union in order, each
-//! collider masked to the lanes that list it, which is each lane's own list in its own
-//! order); a group's row `d` is the `d`-th link of
+//! columns with the same centre in a *group*, whatever their colliders: the group tests a
+//! list that holds each column's list in order, each entry masked to the lanes whose
+//! list it is part of, which is each lane's own list in its own order ([`Merged`]); a group's row `d` is the `d`-th link of
 //! each of its columns. A column that hangs below another column's link (a branching
 //! spring) goes to a later group ([`Group`]s are in order of that depth).
 //!
@@ -63,15 +62,14 @@ pub(crate) struct SpringLanes {
     pays: bool,
 }
 
-/// Up to [`LANES`] columns with the same centre, and the same colliders or colliders
-/// listed in ascending order (each lane then tests its own).
+/// Up to [`LANES`] columns with the same centre (each lane tests its own colliders).
 #[derive(Debug, Clone, PartialEq)]
 struct Group {
     center: Option<usize>,
-    /// The colliders the group's links test, in order: their common list, or the union of
-    /// their ascending lists.
+    /// The colliders the group's links test, in order: their common list, or a list that
+    /// holds each of theirs in order ([`Merged`]).
     colliders: Vec<usize>,
-    /// With a union: per collider, the lanes whose links test it (see [`collide_tail`]).
+    /// With a merged list: per entry, the lanes whose links test it (see [`collide_tail`]).
     masks: Option<Vec<M>>,
     rows: Vec<Row>,
 }
@@ -184,14 +182,6 @@ impl SpringLanes {
         let same_column = |a: usize, b: usize| {
             links[a].center == links[b].center && colliders_of(a) == colliders_of(b)
         };
-        // Columns whose lists are ascending (no collider twice) share a group whatever
-        // their colliders: each lane tests the union's colliders that are its own, in the
-        // union's order, which is its own list's.
-        let ascending = |i: usize| colliders_of(i).windows(2).all(|w| w[0] < w[1]);
-        let same_group = |a: usize, b: usize| {
-            links[a].center == links[b].center
-                && (colliders_of(a) == colliders_of(b) || (ascending(a) && ascending(b)))
-        };
         let mut columns: Vec<Column> = Vec::new();
         let mut column_of = vec![usize::MAX; links.len()];
         for (i, l) in links.iter().enumerate() {
@@ -220,35 +210,36 @@ impl SpringLanes {
                 level,
             });
         }
-        // Shallow levels first; within one, columns that can share a group together
-        // (the same centre; ascending lists, or else the same list), longest first (so
-        // that a row's lanes in use are a prefix).
+        // Shallow levels first; within one, by centre, longest first (so that a row's
+        // lanes in use are a prefix). Then each column joins the group before it when it
+        // has the same level and centre, a lane is free and the group's merged collider
+        // list costs less than a group of its own would (see `Merged::take`).
         let mut order: Vec<usize> = (0..columns.len()).collect();
-        let key = |c: &Column| {
-            let l = c.links[0];
-            let list: &[usize] = if ascending(l) { &[] } else { colliders_of(l) };
-            (c.level, links[l].center, !ascending(l), list)
-        };
         order.sort_by(|&a, &b| {
             let (ca, cb) = (&columns[a], &columns[b]);
-            key(ca)
-                .cmp(&key(cb))
+            (ca.level, links[ca.links[0]].center)
+                .cmp(&(cb.level, links[cb.links[0]].center))
                 .then(cb.links.len().cmp(&ca.links.len()))
         });
         let mut groups = Vec::new();
         let mut start = 0;
         while start < order.len() {
             let head = &columns[order[start]];
+            let mut merged = Merged::new(colliders_of(head.links[0]));
             let mut end = start + 1;
-            while end < order.len()
-                && end - start < LANES
-                && columns[order[end]].level == head.level
-                && same_group(columns[order[end]].links[0], head.links[0])
-            {
+            while end < order.len() && end - start < LANES {
+                let c = &columns[order[end]];
+                let l = c.links[0];
+                if c.level != head.level
+                    || links[l].center != links[head.links[0]].center
+                    || !merged.take(colliders_of(l), head.links.len(), c.links.len())
+                {
+                    break;
+                }
                 end += 1;
             }
             let members: Vec<&Column> = order[start..end].iter().map(|&c| &columns[c]).collect();
-            groups.push(Group::new(sk, rig, &members));
+            groups.push(Group::new(sk, rig, &members, merged));
             start = end;
         }
         let below = (0..n)
@@ -502,7 +493,7 @@ impl SpringLanes {
 }
 
 impl Group {
-    fn new(sk: &Skeleton, rig: &VrmRig, columns: &[&Column]) -> Group {
+    fn new(sk: &Skeleton, rig: &VrmRig, columns: &[&Column], merged: Merged) -> Group {
         let head = &rig.links[columns[0].links[0]];
         let depth = columns.iter().map(|c| c.links.len()).max().unwrap_or(0);
         let rows = (0..depth)
@@ -515,37 +506,101 @@ impl Group {
                 Row::new(sk, rig, n, link)
             })
             .collect();
-        let list = |c: &Column| &rig.link_colliders[rig.links[c.links[0]].colliders.clone()];
-        let mut colliders = list(columns[0]).to_vec();
-        let mut masks = None;
-        if columns.iter().any(|c| list(c) != list(columns[0])) {
-            // Ascending lists (`SpringLanes::new` grouped only those): their union, and
-            // per collider the lanes whose list has it. Lanes past the columns repeat lane
-            // 0's links (never written back) and take its list.
-            colliders = columns
-                .iter()
-                .flat_map(|c| list(c).iter().copied())
-                .collect();
-            colliders.sort_unstable();
-            colliders.dedup();
-            masks = Some(
-                colliders
-                    .iter()
-                    .map(|k| {
-                        M::from_bools(std::array::from_fn(|l| {
-                            list(columns.get(l).unwrap_or(&columns[0])).contains(k)
-                        }))
-                    })
-                    .collect(),
-            );
-        }
+        // One list for all lanes, or the merged list with a mask per entry: the lanes
+        // whose own list took that entry (lanes past the columns repeat lane 0's links,
+        // are never written back, and take its list).
+        let same = merged.places.iter().all(|p| p.len() == merged.list.len());
+        let masks = (!same).then(|| {
+            (0..merged.list.len())
+                .map(|k| {
+                    M::from_bools(std::array::from_fn(|l| {
+                        merged.places[if l < columns.len() { l } else { 0 }].contains(&k)
+                    }))
+                })
+                .collect()
+        });
         Group {
             center: head.center,
-            colliders,
+            colliders: merged.list,
             masks,
             rows,
         }
     }
+}
+
+/// A group's colliders: one list that holds every column's list as a subsequence (the
+/// shortest common supersequence of two lists, by their longest common subsequence, taken
+/// column by column), and where each column's entries are in it. A lane that tests the
+/// entries at its places, in order, tests its own list in its own order.
+#[derive(Debug, Clone, PartialEq)]
+struct Merged {
+    list: Vec<usize>,
+    places: Vec<Vec<usize>>,
+}
+
+impl Merged {
+    fn new(first: &[usize]) -> Merged {
+        Merged {
+            list: first.to_vec(),
+            places: vec![(0..first.len()).collect()],
+        }
+    }
+
+    /// Takes a column's list `b` when the group's cost, `rows` rows each testing the
+    /// merged list, grows by less than a group of its own of `b_rows` rows would cost (a
+    /// row's own work counted as four collider tests). Leaves `self` as it was otherwise.
+    fn take(&mut self, b: &[usize], rows: usize, b_rows: usize) -> bool {
+        let (list, at_a, at_b) = supersequence(&self.list, b);
+        let added = list.len() - self.list.len();
+        if added * rows > b_rows * (4 + b.len()) {
+            return false;
+        }
+        for p in &mut self.places {
+            for k in p.iter_mut() {
+                *k = at_a[*k];
+            }
+        }
+        self.places.push(at_b);
+        self.list = list;
+        true
+    }
+}
+
+/// A shortest common supersequence of `a` and `b` (the longest common subsequence taken
+/// once, the rest of each in order), with where each entry of `a` and of `b` went in it.
+fn supersequence(a: &[usize], b: &[usize]) -> (Vec<usize>, Vec<usize>, Vec<usize>) {
+    let (n, m) = (a.len(), b.len());
+    // lcs[i][j]: the longest common subsequence of a[i..] and b[j..].
+    let mut lcs = vec![vec![0usize; m + 1]; n + 1];
+    for i in (0..n).rev() {
+        for j in (0..m).rev() {
+            lcs[i][j] = if a[i] == b[j] {
+                lcs[i + 1][j + 1] + 1
+            } else {
+                lcs[i + 1][j].max(lcs[i][j + 1])
+            };
+        }
+    }
+    let (mut out, mut at_a, mut at_b) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut i, mut j) = (0, 0);
+    while i < n || j < m {
+        if i < n && j < m && a[i] == b[j] {
+            at_a.push(out.len());
+            at_b.push(out.len());
+            out.push(a[i]);
+            i += 1;
+            j += 1;
+        } else if j == m || (i < n && lcs[i + 1][j] >= lcs[i][j + 1]) {
+            at_a.push(out.len());
+            out.push(a[i]);
+            i += 1;
+        } else {
+            at_b.push(out.len());
+            out.push(b[j]);
+            j += 1;
+        }
+    }
+    (out, at_a, at_b)
 }
 
 impl Row {
@@ -640,5 +695,70 @@ fn placed_in_lanes(p: &PlacedVrmCollider) -> Placed {
             mid: V3::splat(point),
             half: F::splat(0.0),
         },
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{supersequence, Merged};
+
+    /// Every pair of short lists over three colliders (repeats allowed): the result holds
+    /// each list at its places, in order, and is as long as the two less their longest
+    /// common subsequence (counted here by brute force over the subsequences of `a`).
+    #[test]
+    fn supersequence_holds_both_lists_and_is_shortest() {
+        let lists: Vec<Vec<usize>> = (0..40usize)
+            .map(|x| {
+                let len = x % 4;
+                (0..len).map(|i| (x / 4 + i * 2) % 3).collect()
+            })
+            .collect();
+        let is_sub = |s: &[usize], t: &[usize]| {
+            let mut it = t.iter();
+            s.iter().all(|x| it.any(|y| y == x))
+        };
+        for a in &lists {
+            for b in &lists {
+                let (out, at_a, at_b) = supersequence(a, b);
+                for (list, at) in [(a, &at_a), (b, &at_b)] {
+                    assert_eq!(at.len(), list.len());
+                    assert!(at.windows(2).all(|w| w[0] < w[1]), "{a:?} {b:?}");
+                    for (k, &p) in at.iter().enumerate() {
+                        assert_eq!(out[p], list[k]);
+                    }
+                }
+                let lcs = (0..1usize << a.len())
+                    .map(|bits| {
+                        let sub: Vec<usize> = (0..a.len())
+                            .filter(|i| bits >> i & 1 == 1)
+                            .map(|i| a[i])
+                            .collect();
+                        if is_sub(&sub, b) {
+                            sub.len()
+                        } else {
+                            0
+                        }
+                    })
+                    .max()
+                    .unwrap_or(0);
+                assert_eq!(out.len(), a.len() + b.len() - lcs, "{a:?} {b:?} -> {out:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn a_column_joins_while_it_costs_less_than_a_group_of_its_own() {
+        // Rows of the group 7: a list of one new collider costs 7 tests, a group of its
+        // own of 3 rows 3 x (4 + 1) = 15: taken.
+        let mut m = Merged::new(&[2, 4, 3, 5]);
+        assert!(m.take(&[0], 7, 3));
+        // Nothing in common: the group's list first (ties take it), then the new one.
+        assert_eq!(m.list, [2, 4, 3, 5, 0]);
+        assert_eq!(m.places, vec![vec![0, 1, 2, 3], vec![4]]);
+        // Five new colliders on a 1-row column: 5 x 7 = 35 > 1 x (4 + 5): refused, and
+        // the group is as it was.
+        let before = m.clone();
+        assert!(!m.take(&[10, 11, 12, 13, 14], 7, 1));
+        assert_eq!(m, before);
     }
 }
