@@ -31,6 +31,10 @@ pub struct Args {
     /// chains. With FILE: the mode of its solvers (default `fixed`).
     #[arg(long, value_enum)]
     vrm: Option<VrmBenchMode>,
+    /// The bench rig's chains in `classic` mode (KawaiiPhysics 1.10's step each frame)
+    /// instead of `fixed` (to set `fixed`'s cost beside it).
+    #[arg(long, conflicts_with_all = ["vrm", "file", "cloth"])]
+    classic: bool,
     /// The built-in character's skirt (one bone cloth, 4 leg capsules) instead.
     #[arg(long, conflicts_with_all = ["vrm", "file"])]
     cloth: bool,
@@ -122,13 +126,29 @@ fn file_character(a: &Args, path: &PathBuf) -> Result<(CharacterSim, usize, Stri
     Ok((sim, simulated, what))
 }
 
+/// The bench rig's skeleton and chains, in `classic` mode with `--classic`.
+fn bench_chains(
+    a: &Args,
+    chains: usize,
+    joints: usize,
+    colliders: usize,
+) -> (tassel::Skeleton, RigSettings) {
+    let (sk, mut rig) = builtin::bench_character(chains, joints, colliders);
+    if a.classic {
+        for c in &mut rig.chains {
+            c.mode = tassel::dynamics::chain::TimeMode::Classic;
+        }
+    }
+    (sk, rig)
+}
+
 /// One bench character: the simulation, how many joints it simulates, what it is.
 fn character(a: &Args) -> Result<(CharacterSim, usize, String), String> {
     if let Some(path) = &a.file {
         return file_character(a, path);
     }
     let (chains, joints, colliders) = (16, 8, 8);
-    let (sk, rig) = builtin::bench_character(chains, joints, colliders);
+    let (sk, rig) = bench_chains(a, chains, joints, colliders);
     if a.cloth {
         let c = builtin::character();
         let rig = RigSettings {
@@ -154,7 +174,11 @@ fn character(a: &Args) -> Result<(CharacterSim, usize, String), String> {
             Ok((
                 sim,
                 simulated,
-                format!("{chains} chains x {joints} joints, {colliders} colliders, chains, fixed mode 60 Hz, one step per frame"),
+                if a.classic {
+                    format!("{chains} chains x {joints} joints, {colliders} colliders, chains, classic mode, 60 Hz frames")
+                } else {
+                    format!("{chains} chains x {joints} joints, {colliders} colliders, chains, fixed mode 60 Hz, one step per frame")
+                },
             ))
         }
         Some(m) => {
@@ -341,7 +365,7 @@ fn chain_crowd(
     frames: usize,
 ) -> Result<(String, usize, f64), String> {
     let (_, joints, what) = character(a)?;
-    let (sk, settings) = builtin::bench_character(16, 8, 8);
+    let (sk, settings) = bench_chains(a, 16, 8, 8);
     let rig = ChainRig::new(&sk, &settings).map_err(|e| e.to_string())?;
     let rest = sk.rest().to_vec();
     let mut crowd = ChainCrowd::new(Arc::new(sk), Arc::new(rig)).map_err(|e| e.to_string())?;
