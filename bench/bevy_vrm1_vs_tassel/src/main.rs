@@ -22,10 +22,20 @@
 //! the propagation it needs before it, and the whole `App::update`. Medians over rounds
 //! that alternate the apps, so that all see the same machine load.
 //!
+//! **`--avatar`: a real avatar with meshes.** Tassel's built-in character as a VRM 1.0 file
+//! (`tassel_gltf::builtin_avatar()`: 82 joints and a skinned body, 13 springs of 44 joints,
+//! 6 colliders), written to a temporary folder and loaded by Bevy's own glTF loader in
+//! `DefaultPlugins` apps without a renderer (`RenderPlugin` with no wgpu backend: meshes
+//! and skins are loaded, nothing is drawn), N copies swaying, each spawned as its glTF scene
+//! would be (see `spawn_avatar`). Tassel gets the file through `SecondaryMotion` (the path
+//! users take); bevy_vrm1 gets the springs as its components on the same entities (its own
+//! loader needs its MToon renderer).
+//!
 //! Run from the repository root:
-//! `cargo run --release --manifest-path bench/bevy_vrm1_vs_tassel/Cargo.toml -- [N] [--frames F] [--rounds R] [--threads T] [--no-colliders]`
+//! `cargo run --release --manifest-path bench/bevy_vrm1_vs_tassel/Cargo.toml -- [N] [--avatar] [--frames F] [--rounds R] [--threads T] [--no-colliders]`
 //! (`--threads`: Bevy's compute pool; its default on two cores is one thread).
 
+use bevy::mesh::skinning::SkinnedMesh;
 use bevy::prelude::*;
 use bevy::time::TimeUpdateStrategy;
 use bevy::transform::systems::{propagate_parent_transforms, sync_simple_transforms};
@@ -82,19 +92,44 @@ fn mark_end(mut m: ResMut<Marks>) {
 #[derive(Resource, Default)]
 struct Avatars(Vec<Vec<Entity>>);
 
-fn app(engine: Engine, threads: Option<usize>) -> App {
+fn app(engine: Engine, threads: Option<usize>, avatar_folder: Option<&str>) -> App {
     let mut tasks = TaskPoolPlugin::default();
     if let Some(n) = threads {
         tasks.task_pool_options.compute.min_threads = n;
         tasks.task_pool_options.compute.max_threads = n;
     }
     let mut app = App::new();
-    app.add_plugins((
-        MinimalPlugins.set(tasks),
-        AssetPlugin::default(),
-        TransformPlugin,
-    ))
-    .insert_resource(TimeUpdateStrategy::ManualDuration(Duration::from_secs_f64(
+    match avatar_folder {
+        None => {
+            app.add_plugins((
+                MinimalPlugins.set(tasks),
+                AssetPlugin::default(),
+                TransformPlugin,
+            ));
+        }
+        Some(folder) => {
+            use bevy::render::settings::WgpuSettings;
+            use bevy::render::RenderPlugin;
+            app.add_plugins(
+                DefaultPlugins
+                    .set(tasks)
+                    .set(AssetPlugin {
+                        file_path: folder.to_string(),
+                        ..default()
+                    })
+                    .set(RenderPlugin {
+                        render_creation: WgpuSettings {
+                            backends: None,
+                            ..default()
+                        }
+                        .into(),
+                        ..default()
+                    })
+                    .disable::<bevy::log::LogPlugin>(),
+            );
+        }
+    }
+    app.insert_resource(TimeUpdateStrategy::ManualDuration(Duration::from_secs_f64(
         1.0 / 60.0,
     )))
     .init_resource::<Marks>()
@@ -176,6 +211,123 @@ fn spawn(app: &mut App, engine: Engine, n: usize, sk: &Skeleton, vrm: &VrmSpring
     vrm.springs.iter().map(|s| s.joints.len()).sum()
 }
 
+/// N copies of the avatar file under swaying roots, spawned as its glTF scene would be
+/// (Bevy 0.19's scene spawner refuses this file's scene in an app without a render app:
+/// "world contains the unregistered type"): the file's nodes as named entities (its 82
+/// joints by `tassel_bevy::spawn_skeleton`, and its `body` node), under `body` one entity
+/// per primitive with the file's `Mesh3d` and a `SkinnedMesh` on the joints, all loaded
+/// by Bevy's glTF loader. Tassel gets the file through `SecondaryMotion` (its springs read
+/// by Tassel, the path users take); bevy_vrm1 gets the springs as its components. Updates
+/// until the file is loaded (and, for Tassel, every character bound). Returns the simulated
+/// joints per avatar.
+fn spawn_avatar(
+    app: &mut App,
+    engine: Engine,
+    n: usize,
+    sk: &Skeleton,
+    vrm: &VrmSpringBones,
+) -> usize {
+    let tassel = engine == Engine::TasselFixed || engine == Engine::TasselSpec;
+    let assets = app.world().resource::<AssetServer>().clone();
+    let file: Handle<bevy::gltf::Gltf> = assets.load("avatar.vrm");
+    let mut loaded = None;
+    for _ in 0..2000 {
+        app.update();
+        let w = app.world();
+        let (Some(gltf), meshes, skins) = (
+            w.resource::<Assets<bevy::gltf::Gltf>>().get(&file),
+            w.resource::<Assets<bevy::gltf::GltfMesh>>(),
+            w.resource::<Assets<bevy::gltf::GltfSkin>>(),
+        ) else {
+            continue;
+        };
+        let nodes = w.resource::<Assets<bevy::gltf::GltfNode>>();
+        let (Some(mesh), Some(skin)) = (meshes.get(&gltf.meshes[0]), skins.get(&gltf.skins[0]))
+        else {
+            continue;
+        };
+        let joints: Option<Vec<usize>> = skin
+            .joints
+            .iter()
+            .map(|h| nodes.get(h).map(|n| n.index))
+            .collect();
+        let Some(joints) = joints else { continue };
+        let prims: Vec<Handle<Mesh>> = mesh.primitives.iter().map(|p| p.mesh.clone()).collect();
+        loaded = Some((prims, skin.inverse_bind_matrices.clone(), joints));
+        break;
+    }
+    let (prims, bindposes, skin_joints) = loaded.expect("avatar.vrm loaded within 2000 frames");
+    let model = tassel.then(|| assets.load::<TasselModel>("avatar.vrm"));
+    let mut avatars = Vec::with_capacity(n);
+    for i in 0..n {
+        let mut root = app.world_mut().spawn((
+            Transform::default(),
+            Visibility::default(),
+            Sway(0.37 * i as f32),
+        ));
+        if let Some(model) = &model {
+            let mode = if engine == Engine::TasselSpec {
+                SimMode::Spec
+            } else {
+                SimMode::Fixed
+            };
+            root.insert(SecondaryMotion::new(model.clone()).with_mode(mode));
+        }
+        let root = root.id();
+        let entities = tassel_bevy::spawn_skeleton(app.world_mut(), sk, root);
+        let w = app.world_mut();
+        let body = w
+            .spawn((
+                Name::new("body"),
+                Transform::default(),
+                Visibility::default(),
+                ChildOf(root),
+            ))
+            .id();
+        let joints: Vec<Entity> = skin_joints.iter().map(|&j| entities[j]).collect();
+        for mesh in &prims {
+            w.spawn((
+                Mesh3d(mesh.clone()),
+                SkinnedMesh {
+                    inverse_bindposes: bindposes.clone(),
+                    joints: joints.clone(),
+                },
+                Transform::default(),
+                Visibility::default(),
+                ChildOf(body),
+            ));
+        }
+        avatars.push(entities);
+    }
+    if tassel {
+        let mut bound = 0;
+        for _ in 0..2000 {
+            app.update();
+            let w = app.world_mut();
+            bound = w.query::<&TasselCharacter>().iter(w).count();
+            if bound == n {
+                break;
+            }
+        }
+        assert_eq!(bound, n, "every character bound within 2000 frames");
+    }
+    if engine == Engine::BevyVrm1 {
+        for entities in &avatars {
+            add_bevy_vrm1_springs(app, vrm, entities);
+        }
+    }
+    let per_avatar = {
+        let w = app.world_mut();
+        w.query::<&ChildOf>().iter(w).count() / n
+    };
+    println!(
+        "{engine:?}: {n} avatars, {per_avatar} entities below each root ({} primitives)",
+        prims.len()
+    );
+    app.world_mut().resource_mut::<Avatars>().0 = avatars;
+    vrm.springs.iter().map(|s| s.joints.len()).sum()
+}
+
 /// The avatar's springs as bevy_vrm1's components (what its loader inserts).
 fn add_bevy_vrm1_springs(app: &mut App, vrm: &VrmSpringBones, entities: &[Entity]) {
     let colliders: Vec<(Entity, ColliderShape)> = vrm
@@ -235,9 +387,16 @@ fn add_bevy_vrm1_springs(app: &mut App, vrm: &VrmSpringBones, entities: &[Entity
                     stiffness: j.stiffness,
                 });
         }
+        // The colliders of the spring's groups, as the loader lists them.
+        let own: Vec<(Entity, ColliderShape)> = spring
+            .collider_groups
+            .iter()
+            .flat_map(|&g| vrm.collider_groups[g].colliders.iter())
+            .map(|&c| colliders[c].clone())
+            .collect();
         app.world_mut().entity_mut(joints[0]).insert(SpringRoot {
             joints: SpringJoints(joints),
-            colliders: SpringColliders(colliders.clone()),
+            colliders: SpringColliders(own),
             center_node: SpringCenterNode(None),
         });
     }
@@ -271,6 +430,7 @@ fn main() {
     let mut rounds = 5usize;
     let mut threads = None;
     let mut colliders = true;
+    let mut avatar = false;
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         let mut value = || -> usize {
@@ -283,10 +443,25 @@ fn main() {
             "--rounds" => rounds = value(),
             "--threads" => threads = Some(value()),
             "--no-colliders" => colliders = false,
+            "--avatar" => avatar = true,
             _ => n = a.parse().unwrap_or_else(|_| panic!("unknown argument {a}")),
         }
     }
-    let (sk, mut vrm) = tassel::builtin::bench_vrm(2, 9, 4);
+    let (sk, mut vrm) = if avatar {
+        let c = tassel::builtin::character();
+        let springs = tassel::builtin::avatar::spring_bones(&c);
+        (c.skeleton, springs)
+    } else {
+        tassel::builtin::bench_vrm(2, 9, 4)
+    };
+    // The avatar's file, for Bevy's asset server.
+    let folder = std::env::temp_dir().join(format!("tassel-bevy-bench-{}", std::process::id()));
+    if avatar {
+        std::fs::create_dir_all(&folder).expect("a temporary folder");
+        let bytes = tassel_gltf::builtin_avatar().expect("the built-in avatar");
+        std::fs::write(folder.join("avatar.vrm"), bytes).expect("avatar.vrm written");
+    }
+    let folder_name = folder.to_string_lossy().into_owned();
     if !colliders {
         vrm.colliders.clear();
         vrm.collider_groups.clear();
@@ -303,8 +478,14 @@ fn main() {
     let mut apps: Vec<App> = Vec::new();
     let mut joints = 0;
     for &e in &engines {
-        let mut a = app(e, threads);
-        joints = spawn(&mut a, e, n, &sk, &vrm);
+        let mut a = app(e, threads, avatar.then_some(folder_name.as_str()));
+        if avatar {
+            a.finish();
+            a.cleanup();
+            joints = spawn_avatar(&mut a, e, n, &sk, &vrm);
+        } else {
+            joints = spawn(&mut a, e, n, &sk, &vrm);
+        }
         // Bound, initialised and warm.
         for _ in 0..30 {
             a.update();
@@ -346,11 +527,20 @@ fn main() {
         r
     };
     let (spec, theirs) = (rotations(&mut apps[1]), rotations(&mut apps[2]));
-    let worst = spec
+    let angles: Vec<f32> = spec
         .iter()
         .zip(&theirs)
         .map(|(a, b)| a.angle_between(*b))
-        .fold(0.0f32, f32::max);
+        .collect();
+    let worst = angles.iter().copied().fold(0.0f32, f32::max);
+    let names: Vec<&str> = vrm
+        .springs
+        .iter()
+        .flat_map(|s| s.joints.iter().map(|j| sk.name(j.joint)))
+        .collect();
+    if let Some(k) = angles.iter().position(|&a| a == worst) {
+        println!("largest difference at joint '{}'", names[k % names.len()]);
+    }
     let swing = spec
         .iter()
         .zip(
@@ -370,7 +560,9 @@ fn main() {
         .collect();
     let per_joint = |ms: f64| ms * 1e6 / (n * joints) as f64;
     println!(
-        "{n} avatars x {joints} spring joints, 4 colliders; {rounds} rounds x {frames} frames, apps alternating; {} compute threads; medians",
+        "{n} {} x {joints} spring joints, {} colliders; {rounds} rounds x {frames} frames, apps alternating; {} compute threads; medians",
+        if avatar { "copies of the built-in avatar (avatar.vrm, skinned, DefaultPlugins without a renderer)" } else { "bare avatars" },
+        vrm.colliders.len(),
         bevy::tasks::ComputeTaskPool::get().thread_num()
     );
     println!("| app | spring step, ms per frame | ns per joint-step | whole frame, ms |");
