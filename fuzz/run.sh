@@ -8,7 +8,7 @@
 #   fuzz/run.sh TARGET [SECONDS] [-- libFuzzer options...]
 #   fuzz/run.sh all [SECONDS]          # each target in turn
 #
-# Targets: gltf_import, ffi_load (the C ABI's load and frame), rig_toml, state_machine_toml, simulation. The corpus lives in
+# Targets: gltf_import, ffi_load (the C ABI's load and frame), ffi_skeleton (tassel_character_new), rig_toml, state_machine_toml, simulation. The corpus lives in
 # fuzz/corpus/TARGET (not committed; seeded by fuzz/seeds.sh from ../shared/testdata, the
 # example rigs and fuzz/regressions); crashes land in fuzz/artifacts/TARGET. A crash input
 # belongs in fuzz/regressions/TARGET/ with its fix: `cargo test -p tassel-fuzz` replays it.
@@ -31,7 +31,7 @@ cargo build --release -p tassel-fuzz --features libfuzzer --bins \
   --target "$triple" --target-dir target/fuzz
 bash fuzz/seeds.sh
 targets=("$target")
-[ "$target" = all ] && targets=(gltf_import ffi_load rig_toml state_machine_toml simulation)
+[ "$target" = all ] && targets=(gltf_import ffi_load ffi_skeleton rig_toml state_machine_toml simulation)
 for t in "${targets[@]}"; do
   mkdir -p "fuzz/corpus/$t" "fuzz/artifacts/$t"
   dict=()

@@ -4,7 +4,7 @@
 # state machine. Existing corpus files are kept.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-mkdir -p fuzz/corpus/{gltf_import,ffi_load,rig_toml,state_machine_toml,simulation}
+mkdir -p fuzz/corpus/{gltf_import,ffi_load,ffi_skeleton,rig_toml,state_machine_toml,simulation}
 if [ -d ../shared/testdata ]; then
   for f in ../shared/testdata/gltf/* ../shared/testdata/vrm/*; do
     case "$f" in *.glb|*.gltf|*.vrm) cp -n "$f" fuzz/corpus/gltf_import/ ;; esac

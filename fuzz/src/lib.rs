@@ -123,6 +123,114 @@ pub fn ffi_load(data: &[u8]) {
     }
 }
 
+/// `tassel_character_new` on a skeleton made from the bytes: the first byte is the joint
+/// count (0–40), then per joint a parent byte (`b % (n + 2) - 1`: -1, a joint, or one past
+/// the end), a name byte (names repeat when bytes do) and ten floats of four bytes each
+/// (NaN, infinities and zero rotations included); what is left is the springs JSON (UTF-8,
+/// lossy) — or, when it starts with `[`, a rig file. A character that is made is stepped
+/// four frames: every call returns 0 or -1 with a message, every output float is finite.
+pub fn ffi_skeleton(data: &[u8]) {
+    ffi_skeleton_made(data);
+}
+
+/// [`ffi_skeleton`], returning how many of its two modes made a character.
+#[allow(unsafe_code)]
+pub fn ffi_skeleton_made(data: &[u8]) -> usize {
+    use std::ffi::{CStr, CString};
+    use tassel_ffi::abi::*;
+    let mut made = 0;
+    let Some((&count, mut rest_bytes)) = data.split_first() else {
+        return made;
+    };
+    let n = count as usize % 41;
+    let mut names = Vec::with_capacity(n);
+    let mut parents = Vec::with_capacity(n);
+    let mut rest = Vec::with_capacity(n * 10);
+    for j in 0..n {
+        let take = |bytes: &mut &[u8], k: usize| -> Vec<u8> {
+            let (a, b) = bytes.split_at(k.min(bytes.len()));
+            *bytes = b;
+            a.to_vec()
+        };
+        let head = take(&mut rest_bytes, 2);
+        let parent = head
+            .first()
+            .map_or(-1, |&b| (b as i32 % (n as i32 + 2)) - 1);
+        parents.push(parent);
+        names.push(CString::new(format!("j{}", head.get(1).copied().unwrap_or(j as u8))).unwrap());
+        for _ in 0..10 {
+            let b = take(&mut rest_bytes, 4);
+            let v = if b.len() == 4 {
+                f32::from_le_bytes([b[0], b[1], b[2], b[3]])
+            } else {
+                // Short input: the identity's floats.
+                [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0][rest.len() % 10]
+            };
+            rest.push(v);
+        }
+    }
+    let text = String::from_utf8_lossy(rest_bytes).replace('\0', " ");
+    let text = CString::new(text).unwrap();
+    let (rig, springs) = if rest_bytes.first() == Some(&b'[') {
+        (text.as_ptr(), std::ptr::null())
+    } else {
+        (std::ptr::null(), text.as_ptr())
+    };
+    let name_ptrs: Vec<*const std::ffi::c_char> = names.iter().map(|s| s.as_ptr()).collect();
+    for mode in [c"fixed", c"spec"] {
+        // SAFETY: `n` names, parents and 10 n floats; the strings are NUL-terminated.
+        let c = unsafe {
+            tassel_character_new(
+                name_ptrs.as_ptr(),
+                parents.as_ptr(),
+                rest.as_ptr(),
+                n,
+                rig,
+                springs,
+                mode.as_ptr(),
+            )
+        };
+        if c.is_null() {
+            let e = tassel_last_error();
+            assert!(
+                !e.is_null(),
+                "ffi_skeleton: a refused skeleton left no message"
+            );
+            // SAFETY: a NUL-terminated string of this thread, alive until its next error.
+            assert!(!unsafe { CStr::from_ptr(e) }.to_bytes().is_empty());
+            continue;
+        }
+        made += 1;
+        // SAFETY: `c` is live; every buffer is as long as the length given.
+        unsafe {
+            assert_eq!(tassel_joint_count(c), n);
+            let mut locals = vec![0.0f32; n * 10];
+            assert_eq!(tassel_rest_locals(c, locals.as_mut_ptr(), locals.len()), 0);
+            let mut out = vec![0.0f32; n * 10];
+            for f in 0..4 {
+                let x = 0.3 * (f as f32 * 0.7).sin();
+                let root = [x, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0];
+                let ok = tassel_frame(
+                    c,
+                    root.as_ptr(),
+                    locals.as_ptr(),
+                    out.as_mut_ptr(),
+                    out.len(),
+                    1.0 / 30.0,
+                );
+                if ok == 0 {
+                    assert!(
+                        out.iter().all(|v| v.is_finite()),
+                        "ffi_skeleton: a non-finite output"
+                    );
+                }
+            }
+            tassel_character_free(c);
+        }
+    }
+    made
+}
+
 /// A crowd of two characters of `kind` for a few frames (`rest`: the kind's rest locals):
 /// every output finite, a short buffer refused.
 ///

@@ -76,6 +76,36 @@ fn ffi_load_replays() {
     assert!(n >= 8, "only {n} inputs");
 }
 
+/// `tassel_character_new` on its regressions (hand-made: a valid chain with VRM 1.0 and
+/// VRM 0.x springs, a cycle, a NaN rest, a rig) and a fixed sweep of byte patterns.
+#[test]
+fn ffi_skeleton_replays() {
+    let n = replay("ffi_skeleton", tassel_fuzz::ffi_skeleton, &[]);
+    // The hand-made inputs do what they say: the VRM chains make a character in both
+    // modes, the chain rig in `fixed` only (`spec` is a VRM mode), the cycle, the NaN and
+    // the repeated names none.
+    let dir = root().join("regressions/ffi_skeleton");
+    for (file, want) in [
+        ("chain_vrm1.bin", 2),
+        ("chain_vrm0.bin", 2),
+        ("rig.bin", 1),
+        ("cycle.bin", 0),
+        ("nan_rest.bin", 0),
+        ("repeated_names.bin", 0),
+    ] {
+        let data = std::fs::read(dir.join(file)).unwrap();
+        assert_eq!(tassel_fuzz::ffi_skeleton_made(&data), want, "{file}");
+    }
+    for seed in 0u64..200 {
+        let mut rng = tassel::rng::SplitMix64::new(seed);
+        let len = 1 + (rng.next_u64() % 600) as usize;
+        let mut data: Vec<u8> = (0..len).map(|_| rng.next_u64() as u8).collect();
+        data[0] %= 8;
+        tassel_fuzz::ffi_skeleton(&data);
+    }
+    assert!(n >= 4, "only {n} inputs");
+}
+
 #[test]
 fn rig_toml_replays() {
     let seeds = files(&root().join("../examples/rigs"));

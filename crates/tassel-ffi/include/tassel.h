@@ -47,6 +47,31 @@ TasselCharacter *tassel_character_load(const uint8_t *bytes,
                                        const char *rig_toml,
                                        const char *mode);
 
+// A character from a skeleton the caller owns (an engine's or a tool's: Blender's
+// armature, Godot's `Skeleton3D`, Unreal's `USkeleton`, a Unity `Transform` tree), not a
+// file: `joint_count` joints with their `names` (UTF-8, NUL-terminated, unique, not
+// empty), `parents` (-1 for a root; any order, no cycle) and `rest` local transforms
+// (`joint_count * 10` floats, as `tassel_frame`), plus a rig file's text (`rig_toml`),
+// and/or VRM spring bones as JSON text (`springs_json`: a `VRMC_springBone` 1.0 extension
+// object, or VRM 0.x's `secondaryAnimation`, with node indices into this joint list),
+// and a mode (NULL: `fixed`, as `tassel_character_load`). Every buffer of the other
+// calls keeps this joint order. A VRM 0.x bone group walks a joint's children in this
+// list's order. The character is left as `tassel_character_load` leaves one.
+//
+// NULL on error; `tassel_last_error()` names the joint or the key.
+//
+// # Safety
+// `names` points to `joint_count` NUL-terminated strings; `parents` to `joint_count`
+// entries; `rest` to `joint_count * 10` floats; `rig_toml`, `springs_json` and `mode` are
+// NULL or NUL-terminated.
+TasselCharacter *tassel_character_new(const char *const *names,
+                                      const int32_t *parents,
+                                      const float *rest,
+                                      size_t joint_count,
+                                      const char *rig_toml,
+                                      const char *springs_json,
+                                      const char *mode);
+
 // As `tassel_character_load`, from a file's path (UTF-8): a `.gltf` may read its
 // buffers beside it.
 //

@@ -172,6 +172,85 @@ pub unsafe extern "C" fn tassel_character_load(
     })
 }
 
+/// A character from a skeleton the caller owns (an engine's or a tool's: Blender's
+/// armature, Godot's `Skeleton3D`, Unreal's `USkeleton`, a Unity `Transform` tree), not a
+/// file: `joint_count` joints with their `names` (UTF-8, NUL-terminated, unique, not
+/// empty), `parents` (-1 for a root; any order, no cycle) and `rest` local transforms
+/// (`joint_count * 10` floats, as `tassel_frame`), plus a rig file's text (`rig_toml`),
+/// and/or VRM spring bones as JSON text (`springs_json`: a `VRMC_springBone` 1.0 extension
+/// object, or VRM 0.x's `secondaryAnimation`, with node indices into this joint list),
+/// and a mode (NULL: `fixed`, as `tassel_character_load`). Every buffer of the other
+/// calls keeps this joint order. A VRM 0.x bone group walks a joint's children in this
+/// list's order. The character is left as `tassel_character_load` leaves one.
+///
+/// NULL on error; `tassel_last_error()` names the joint or the key.
+///
+/// # Safety
+/// `names` points to `joint_count` NUL-terminated strings; `parents` to `joint_count`
+/// entries; `rest` to `joint_count * 10` floats; `rig_toml`, `springs_json` and `mode` are
+/// NULL or NUL-terminated.
+#[no_mangle]
+pub unsafe extern "C" fn tassel_character_new(
+    names: *const *const c_char,
+    parents: *const i32,
+    rest: *const f32,
+    joint_count: usize,
+    rig_toml: *const c_char,
+    springs_json: *const c_char,
+    mode: *const c_char,
+) -> *mut TasselCharacter {
+    guard("tassel_character_new", std::ptr::null_mut(), || {
+        if names.is_null() || parents.is_null() {
+            return Err("names or parents is NULL".into());
+        }
+        if joint_count > tassel::MAX_JOINTS {
+            return Err(format!(
+                "{joint_count} joints; at most {} are taken",
+                tassel::MAX_JOINTS
+            ));
+        }
+        if !(names as usize).is_multiple_of(std::mem::align_of::<*const c_char>())
+            || !(parents as usize).is_multiple_of(std::mem::align_of::<i32>())
+        {
+            return Err("names or parents is not aligned".into());
+        }
+        // SAFETY: non-NULL, aligned, `joint_count` entries by the caller's promise.
+        let (name_ptrs, parent_list) = unsafe {
+            (
+                std::slice::from_raw_parts(names, joint_count),
+                std::slice::from_raw_parts(parents, joint_count),
+            )
+        };
+        let mut joint_names = Vec::with_capacity(joint_count);
+        for (j, &p) in name_ptrs.iter().enumerate() {
+            // SAFETY: NULL or NUL-terminated, by the caller's promise.
+            let name = unsafe { opt_str(p, &format!("the name of joint {j}"))? }
+                .ok_or_else(|| format!("the name of joint {j} is NULL"))?;
+            joint_names.push(name);
+        }
+        let parents: Vec<i64> = parent_list.iter().map(|&p| p as i64).collect();
+        // SAFETY: `joint_count * 10` floats by the caller's promise (checked for NULL
+        // and alignment).
+        let rest = unsafe { floats(rest, joint_count * FLOATS_PER_JOINT, "rest")? };
+        // SAFETY: NULL or NUL-terminated, by the caller's promise.
+        let (rig, springs, mode) = unsafe {
+            (
+                opt_str(rig_toml, "rig_toml")?,
+                opt_str(springs_json, "springs_json")?,
+                opt_str(mode, "mode")?,
+            )
+        };
+        Ok(new_character(FlatCharacter::from_skeleton(
+            &joint_names,
+            &parents,
+            rest,
+            rig,
+            springs,
+            mode,
+        )?))
+    })
+}
+
 /// As `tassel_character_load`, from a file's path (UTF-8): a `.gltf` may read its
 /// buffers beside it.
 ///

@@ -80,6 +80,61 @@ fn read_nodes(sim: &CharacterSim, joint_to_node: &[usize]) -> Vec<usize> {
     nodes
 }
 
+/// The largest springs JSON taken (16 MiB, as a rig file).
+pub const MAX_SPRINGS_JSON_BYTES: usize = 16 << 20;
+
+/// VRM spring bones from JSON text with node indices into the caller's joint list (see
+/// [`FlatCharacter::from_skeleton`]), read by the file loader's own reader on a glTF
+/// document made of the joints (names, children in list order, rest translations) and the
+/// extension.
+fn springs_from_json(
+    text: &str,
+    names: &[&str],
+    parents: &[i64],
+    rest: &[f32],
+    node_to_joint: &[usize],
+) -> Result<VrmSpringBones, String> {
+    use serde_json::{json, Value};
+    if text.len() > MAX_SPRINGS_JSON_BYTES {
+        return Err(format!(
+            "the springs JSON is larger than the limit of {MAX_SPRINGS_JSON_BYTES} bytes"
+        ));
+    }
+    let ext: Value = serde_json::from_str(text).map_err(|e| format!("springs JSON: {e}"))?;
+    let Some(obj) = ext.as_object() else {
+        return Err("springs JSON: not an object".into());
+    };
+    let extensions = if obj.contains_key("springs") || obj.contains_key("specVersion") {
+        json!({ "VRMC_springBone": ext })
+    } else if obj.contains_key("boneGroups") {
+        json!({ "VRM": { "secondaryAnimation": ext } })
+    } else {
+        return Err(
+            "springs JSON: neither a VRMC_springBone object (springs, specVersion) \
+                    nor VRM 0.x's secondaryAnimation (boneGroups)"
+                .into(),
+        );
+    };
+    let n = names.len();
+    let mut children = vec![Vec::new(); n];
+    for (j, &p) in parents.iter().enumerate() {
+        if p >= 0 {
+            children[p as usize].push(j);
+        }
+    }
+    let nodes: Vec<Value> = (0..n)
+        .map(|j| {
+            let t = &rest[j * FLOATS_PER_JOINT..j * FLOATS_PER_JOINT + 3];
+            json!({ "name": names[j], "children": children[j], "translation": t })
+        })
+        .collect();
+    let doc = json!({ "nodes": nodes, "extensions": extensions });
+    let mut warnings = Vec::new();
+    let info = tassel_gltf::read_spring_bones(&doc, node_to_joint, &mut warnings)
+        .map_err(|e| e.to_string().replace("<json>: ", ""))?;
+    Ok(info.map(|i| i.springs).unwrap_or_default())
+}
+
 /// `"fixed"`, `"spec"`, `"three-vrm"` or `"classic"` (as `tassel simulate --mode`).
 pub fn parse_mode(name: &str) -> Result<SimMode, String> {
     [
@@ -129,6 +184,118 @@ impl FlatCharacter {
         mode: Option<&str>,
     ) -> Result<Self, String> {
         let vrm: VrmSpringBones = model.vrm.map(|v| v.springs).unwrap_or_default();
+        Self::from_parts(
+            model.skeleton,
+            model.node_to_joint,
+            model.joint_to_node,
+            vrm,
+            rig_toml,
+            mode,
+        )
+    }
+
+    /// A character from a skeleton the caller owns (an engine's or a tool's, not a file):
+    /// joint names (unique, not empty), parents (`-1` for a root; any order, no cycle),
+    /// rest local transforms (10 floats a joint, as [`frame`](Self::frame)), an optional
+    /// rig file's text, optional VRM spring bones as JSON text — a `VRMC_springBone` 1.0
+    /// extension object (it has `springs` or `specVersion`) or VRM 0.x's
+    /// `secondaryAnimation` (it has `boneGroups`), with node indices into the joint list —
+    /// and an optional mode. Either rig input, or both, may be given. Every buffer keeps
+    /// the caller's joint order. A VRM 0.x bone group walks each joint's children in the
+    /// joint list's order; its leaf joints get a tail along their rest translation.
+    ///
+    /// A rest rotation whose length is within 1e-6 of 1 is used as given (bit for bit);
+    /// another one is normalized; a zero or non-finite one is an error naming the joint.
+    /// The file loader ([`load`](Self::load)) and this constructor share everything after
+    /// the skeleton and the springs are read.
+    pub fn from_skeleton(
+        names: &[&str],
+        parents: &[i64],
+        rest: &[f32],
+        rig_toml: Option<&str>,
+        springs_json: Option<&str>,
+        mode: Option<&str>,
+    ) -> Result<Self, String> {
+        let n = names.len();
+        if n == 0 {
+            return Err("no joints".into());
+        }
+        if n > tassel::MAX_JOINTS {
+            return Err(format!(
+                "{n} joints; at most {} are taken",
+                tassel::MAX_JOINTS
+            ));
+        }
+        if parents.len() != n {
+            return Err(format!(
+                "{} parents for {n} joints (one each, -1 for a root)",
+                parents.len()
+            ));
+        }
+        if rest.len() != n * FLOATS_PER_JOINT {
+            return Err(format!(
+                "rest holds {} floats; {n} joints need {}",
+                rest.len(),
+                n * FLOATS_PER_JOINT
+            ));
+        }
+        let mut seen = std::collections::HashMap::new();
+        let mut builder = tassel::SkeletonBuilder::new();
+        for (j, &name) in names.iter().enumerate() {
+            if name.is_empty() {
+                return Err(format!("joint {j} has no name"));
+            }
+            if let Some(k) = seen.insert(name, j) {
+                return Err(format!("joint {j} repeats the name '{name}' of joint {k}"));
+            }
+            let parent = match parents[j] {
+                -1 => None,
+                p if p >= 0 && (p as usize) < n && p as usize != j => Some(p as usize),
+                p => {
+                    return Err(format!(
+                        "joint {j} ('{name}'): parent {p} is not -1 or another joint (0..{n})"
+                    ))
+                }
+            };
+            let mut t = read(&rest[j * FLOATS_PER_JOINT..(j + 1) * FLOATS_PER_JOINT]);
+            let len2 = t.rotation.length_squared();
+            if !t.is_finite() || len2 <= 1e-12 {
+                return Err(format!(
+                    "joint {j} ('{name}'): the rest transform must be finite, its rotation not zero"
+                ));
+            }
+            if (len2 - 1.0).abs() > 2e-6 {
+                t.rotation = t.rotation.normalize();
+            }
+            builder.add(name, parent, t);
+        }
+        let (skeleton, node_to_joint) = builder.build().map_err(|e| match e {
+            tassel::Error::Cycle(name) => {
+                format!("the parents make a cycle through joint '{name}'")
+            }
+            e => e.to_string(),
+        })?;
+        let mut joint_to_node = vec![0; n];
+        for (node, &j) in node_to_joint.iter().enumerate() {
+            joint_to_node[j] = node;
+        }
+        let vrm = match springs_json {
+            None => VrmSpringBones::default(),
+            Some(text) => springs_from_json(text, names, parents, rest, &node_to_joint)?,
+        };
+        vrm.validate_for(&skeleton)
+            .map_err(|e| format!("spring bones: {e}"))?;
+        Self::from_parts(skeleton, node_to_joint, joint_to_node, vrm, rig_toml, mode)
+    }
+
+    fn from_parts(
+        skeleton: Skeleton,
+        node_to_joint: Vec<usize>,
+        joint_to_node: Vec<usize>,
+        vrm: VrmSpringBones,
+        rig_toml: Option<&str>,
+        mode: Option<&str>,
+    ) -> Result<Self, String> {
         let mut rig = match rig_toml {
             Some(text) if text.len() > MAX_RIG_BYTES => {
                 return Err(format!(
@@ -138,7 +305,7 @@ impl FlatCharacter {
             Some(text) => RigSettings::from_toml_str(text).map_err(|e| format!("rig: {e}"))?,
             None if !vrm.is_empty() => RigSettings::default(),
             None => {
-                return Err("the file has no VRM spring bones; give a rig file (TOML) \
+                return Err("no VRM spring bones; give a rig file (TOML) \
                             with its chains, springs, cloths or ropes"
                     .into())
             }
@@ -146,14 +313,12 @@ impl FlatCharacter {
         let requested = mode.map(parse_mode).transpose()?;
         let (mode, options) = SimMode::apply(requested, &mut rig, !vrm.is_empty())
             .map_err(|e| format!("mode: {e}"))?;
-        let skeleton: Skeleton = model.skeleton;
         let rest = skeleton.rest().to_vec();
         let mut sim =
             CharacterSim::with_vrm(skeleton, &rig, &vrm, options).map_err(|e| e.to_string())?;
         // The state before `tassel simulate`'s frame 1.
         sim.frame(&rest, Transform::IDENTITY, 0.0)
             .map_err(|e| e.to_string())?;
-        let joint_to_node = model.joint_to_node;
         let mut written: Vec<usize> = sim
             .simulated_joints()
             .iter()
@@ -164,7 +329,7 @@ impl FlatCharacter {
         Ok(Self {
             sim,
             mode,
-            node_to_joint: model.node_to_joint,
+            node_to_joint,
             joint_to_node,
             written,
             read,
