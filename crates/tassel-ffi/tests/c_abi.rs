@@ -7,7 +7,10 @@
 //! Both programs also check the ABI's promises on bad input (NULL, wrong lengths, NaN,
 //! overlapping buffers: errors with messages that change nothing). The Python program also
 //! runs the crowd functions (`tassel_crowd_*`): three members against three characters of
-//! their own, bit for bit, and a member's NaN held.
+//! their own, bit for bit, and a member's NaN held. `tests/c/skeleton.c` and
+//! `tests/python/skeleton.py` make a character with `tassel_character_new` from what a
+//! loaded one reports (joints, parents, rest pose) and the file's springs JSON, and
+//! require the loaded one's frames byte for byte.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -232,6 +235,75 @@ fn a_python_program_matches_tassel_simulate() {
             "frame.py compared no crowd output"
         );
         assert!(d <= 1e-6, "{} {mode}: {d} m", file.display());
+    }
+}
+
+/// The file's spring bones as JSON text (its `VRMC_springBone`, else VRM 0.x's
+/// `secondaryAnimation`), written beside the test's other outputs.
+fn springs_json_file(file: &Path) -> PathBuf {
+    let bytes = std::fs::read(file).unwrap();
+    let len = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
+    let json: serde_json::Value = serde_json::from_slice(&bytes[20..20 + len]).unwrap();
+    let ext = &json["extensions"];
+    let springs = ext
+        .get("VRMC_springBone")
+        .or_else(|| ext.get("VRM").and_then(|v| v.get("secondaryAnimation")))
+        .expect("a VRM file has spring bones");
+    let out = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(format!(
+        "{}.springs.json",
+        file.file_name().unwrap().to_string_lossy()
+    ));
+    std::fs::write(&out, springs.to_string()).unwrap();
+    out
+}
+
+/// `tassel_character_new` from C and from Python: for every VRM test file, the joints,
+/// parents and rest pose its loaded character reports plus its own springs JSON step the
+/// same frames, byte for byte, as the loaded character (C in every VRM mode, Python in
+/// `fixed`); a cycle (C) and a repeated name (Python) are refused with a message.
+#[test]
+fn c_and_python_make_a_character_from_a_skeleton() {
+    let files = vrm_files();
+    if files.is_empty() {
+        return;
+    }
+    let exe = compile_c(
+        &manifest().join("tests/c/skeleton.c"),
+        "tassel-ffi-skeleton",
+    );
+    let lib = library(&format!(
+        "{}tassel_ffi{}",
+        std::env::consts::DLL_PREFIX,
+        std::env::consts::DLL_SUFFIX
+    ));
+    let python = std::env::var("PYTHON").unwrap_or_else(|_| "python3".into());
+    for file in &files {
+        let json = springs_json_file(file);
+        for mode in ["fixed", "spec", "three-vrm"] {
+            let out = run(
+                Command::new(&exe).arg(file).arg(&json).args([mode, "120"]),
+                &format!("skeleton {} {mode}", file.display()),
+            );
+            assert!(
+                String::from_utf8_lossy(&out).contains("SAME 120"),
+                "{}",
+                file.display()
+            );
+        }
+        let out = run(
+            Command::new(&python)
+                .arg(manifest().join("tests/python/skeleton.py"))
+                .arg(&lib)
+                .arg(file)
+                .arg(&json)
+                .args(["fixed", "120"]),
+            &format!("skeleton.py {}", file.display()),
+        );
+        assert!(
+            String::from_utf8_lossy(&out).contains("SAME 120"),
+            "{}",
+            file.display()
+        );
     }
 }
 
