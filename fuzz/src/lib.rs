@@ -83,43 +83,58 @@ pub fn ffi_load(data: &[u8]) {
             assert!(!message.is_empty(), "ffi_load: an empty message");
             continue;
         }
-        // SAFETY: `c` is a live character; every buffer is as long as the length given.
+        // SAFETY: `c` is a live character from a load, freed here.
         unsafe {
-            let n = tassel_joint_count(c);
-            let mut locals = vec![0.0f32; n * 10];
-            assert_eq!(tassel_rest_locals(c, locals.as_mut_ptr(), locals.len()), 0);
-            let mut out = vec![0.0f32; n * 10];
-            for f in 0..4 {
-                let x = 0.3 * (f as f32 * 0.7).sin();
-                let root = [x, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0];
-                let ok = tassel_frame(
-                    c,
-                    root.as_ptr(),
-                    locals.as_ptr(),
-                    out.as_mut_ptr(),
-                    out.len(),
-                    1.0 / 30.0,
-                );
-                if ok == 0 {
-                    assert!(
-                        out.iter().all(|v| v.is_finite()),
-                        "ffi_load: a non-finite output"
-                    );
-                }
-                let short = tassel_frame(
-                    c,
-                    root.as_ptr(),
-                    locals.as_ptr(),
-                    out.as_mut_ptr(),
-                    out.len().saturating_sub(1),
-                    1.0 / 30.0,
-                );
-                assert_eq!(short, -1, "ffi_load: a short buffer was taken");
-            }
-            assert!(tassel_joint_name(c, n).is_null());
-            ffi_crowd(c, &locals);
+            exercise(c, "ffi_load");
             tassel_character_free(c);
         }
+    }
+}
+
+/// A made character stepped on a swaying root for four frames: every call returns 0 or -1
+/// with a message, every output float is finite, a short buffer is refused, no joint past
+/// the end has a name; then a crowd of two of it (`what` names the target in messages).
+///
+/// # Safety
+/// `c` is a live character.
+#[allow(unsafe_code)]
+unsafe fn exercise(c: *mut tassel_ffi::abi::TasselCharacter, what: &str) {
+    use tassel_ffi::abi::*;
+    // SAFETY: the caller's promise; every buffer is as long as the length given.
+    unsafe {
+        let n = tassel_joint_count(c);
+        let mut locals = vec![0.0f32; n * 10];
+        assert_eq!(tassel_rest_locals(c, locals.as_mut_ptr(), locals.len()), 0);
+        let mut out = vec![0.0f32; n * 10];
+        for f in 0..4 {
+            let x = 0.3 * (f as f32 * 0.7).sin();
+            let root = [x, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0];
+            let ok = tassel_frame(
+                c,
+                root.as_ptr(),
+                locals.as_ptr(),
+                out.as_mut_ptr(),
+                out.len(),
+                1.0 / 30.0,
+            );
+            if ok == 0 {
+                assert!(
+                    out.iter().all(|v| v.is_finite()),
+                    "{what}: a non-finite output"
+                );
+            }
+            let short = tassel_frame(
+                c,
+                root.as_ptr(),
+                locals.as_ptr(),
+                out.as_mut_ptr(),
+                out.len().saturating_sub(1),
+                1.0 / 30.0,
+            );
+            assert_eq!(short, -1, "{what}: a short buffer was taken");
+        }
+        assert!(tassel_joint_name(c, n).is_null());
+        ffi_crowd(c, &locals);
     }
 }
 
@@ -127,8 +142,8 @@ pub fn ffi_load(data: &[u8]) {
 /// count (0–40), then per joint a parent byte (`b % (n + 2) - 1`: -1, a joint, or one past
 /// the end), a name byte (names repeat when bytes do) and ten floats of four bytes each
 /// (NaN, infinities and zero rotations included); what is left is the springs JSON (UTF-8,
-/// lossy) — or, when it starts with `[`, a rig file. A character that is made is stepped
-/// four frames: every call returns 0 or -1 with a message, every output float is finite.
+/// lossy) — or, when it starts with `[`, a rig file. A character that is made is exercised
+/// as [`ffi_load`]'s are (frames, a short buffer, a crowd of two).
 pub fn ffi_skeleton(data: &[u8]) {
     ffi_skeleton_made(data);
 }
@@ -201,30 +216,10 @@ pub fn ffi_skeleton_made(data: &[u8]) -> usize {
             continue;
         }
         made += 1;
-        // SAFETY: `c` is live; every buffer is as long as the length given.
+        // SAFETY: `c` is a live character just made, freed here.
         unsafe {
             assert_eq!(tassel_joint_count(c), n);
-            let mut locals = vec![0.0f32; n * 10];
-            assert_eq!(tassel_rest_locals(c, locals.as_mut_ptr(), locals.len()), 0);
-            let mut out = vec![0.0f32; n * 10];
-            for f in 0..4 {
-                let x = 0.3 * (f as f32 * 0.7).sin();
-                let root = [x, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0];
-                let ok = tassel_frame(
-                    c,
-                    root.as_ptr(),
-                    locals.as_ptr(),
-                    out.as_mut_ptr(),
-                    out.len(),
-                    1.0 / 30.0,
-                );
-                if ok == 0 {
-                    assert!(
-                        out.iter().all(|v| v.is_finite()),
-                        "ffi_skeleton: a non-finite output"
-                    );
-                }
-            }
+            exercise(c, "ffi_skeleton");
             tassel_character_free(c);
         }
     }

@@ -179,6 +179,15 @@ fn app(engine: Engine, threads: Option<usize>, avatar_folder: Option<&str>) -> A
     app
 }
 
+/// The mode a Tassel app runs in.
+fn mode_of(engine: Engine) -> SimMode {
+    if engine == Engine::TasselSpec {
+        SimMode::Spec
+    } else {
+        SimMode::Fixed
+    }
+}
+
 /// N avatars: the skeleton as named entities under a swaying root, with each engine's
 /// components. Returns the number of simulated joints per avatar.
 fn spawn(app: &mut App, engine: Engine, n: usize, sk: &Skeleton, vrm: &VrmSpringBones) -> usize {
@@ -193,12 +202,7 @@ fn spawn(app: &mut App, engine: Engine, n: usize, sk: &Skeleton, vrm: &VrmSpring
             .world_mut()
             .spawn((Transform::default(), Sway(0.37 * i as f32)));
         if let Some(model) = &model {
-            let mode = if engine == Engine::TasselSpec {
-                SimMode::Spec
-            } else {
-                SimMode::Fixed
-            };
-            root.insert(SecondaryMotion::new(model.clone()).with_mode(mode));
+            root.insert(SecondaryMotion::new(model.clone()).with_mode(mode_of(engine)));
         }
         let root = root.id();
         let entities = tassel_bevy::spawn_skeleton(app.world_mut(), &sk, root);
@@ -266,12 +270,7 @@ fn spawn_avatar(
             Sway(0.37 * i as f32),
         ));
         if let Some(model) = &model {
-            let mode = if engine == Engine::TasselSpec {
-                SimMode::Spec
-            } else {
-                SimMode::Fixed
-            };
-            root.insert(SecondaryMotion::new(model.clone()).with_mode(mode));
+            root.insert(SecondaryMotion::new(model.clone()).with_mode(mode_of(engine)));
         }
         let root = root.id();
         let entities = tassel_bevy::spawn_skeleton(app.world_mut(), sk, root);

@@ -153,6 +153,15 @@ fn run(cmd: &mut Command, what: &str) -> Vec<u8> {
     out.stdout
 }
 
+/// The shared library Python loads (`libtassel_ffi.so` and the like).
+fn shared_library() -> PathBuf {
+    library(&format!(
+        "{}tassel_ffi{}",
+        std::env::consts::DLL_PREFIX,
+        std::env::consts::DLL_SUFFIX
+    ))
+}
+
 /// `source` compiled with the system's C compiler (`$CC`, else `cc`; warnings are errors)
 /// against `include/tassel.h` and the static library, into the test's scratch folder.
 fn compile_c(source: &Path, name: &str) -> PathBuf {
@@ -210,11 +219,7 @@ fn a_python_program_matches_tassel_simulate() {
     if files.is_empty() {
         return;
     }
-    let lib = library(&format!(
-        "{}tassel_ffi{}",
-        std::env::consts::DLL_PREFIX,
-        std::env::consts::DLL_SUFFIX
-    ));
+    let lib = shared_library();
     let python = std::env::var("PYTHON").unwrap_or_else(|_| "python3".into());
     for file in &files {
         let mode = "three-vrm";
@@ -271,11 +276,7 @@ fn c_and_python_make_a_character_from_a_skeleton() {
         &manifest().join("tests/c/skeleton.c"),
         "tassel-ffi-skeleton",
     );
-    let lib = library(&format!(
-        "{}tassel_ffi{}",
-        std::env::consts::DLL_PREFIX,
-        std::env::consts::DLL_SUFFIX
-    ));
+    let lib = shared_library();
     let python = std::env::var("PYTHON").unwrap_or_else(|_| "python3".into());
     for file in &files {
         let json = springs_json_file(file);

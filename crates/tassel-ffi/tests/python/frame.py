@@ -12,26 +12,12 @@ import ctypes.util
 import math
 import sys
 
+import tassel_abi
+
 lib_path, path, mode, frames, dt, amp, freq = sys.argv[1:8]
 frames, dt, amp, freq = int(frames), float(dt), float(amp), float(freq)
-lib = ctypes.CDLL(lib_path)
-
-P = ctypes.c_void_p
-FLOATS = ctypes.POINTER(ctypes.c_float)
-lib.tassel_character_load.restype = P
-lib.tassel_character_load.argtypes = [ctypes.c_char_p, ctypes.c_size_t, ctypes.c_char_p, ctypes.c_char_p]
-lib.tassel_character_free.argtypes = [P]
-lib.tassel_joint_count.restype = ctypes.c_size_t
-lib.tassel_joint_count.argtypes = [P]
-lib.tassel_joint_parent.restype = ctypes.c_int32
-lib.tassel_joint_parent.argtypes = [P, ctypes.c_size_t]
-lib.tassel_joint_name.restype = ctypes.c_char_p
-lib.tassel_joint_name.argtypes = [P, ctypes.c_size_t]
-lib.tassel_rest_locals.restype = ctypes.c_int32
-lib.tassel_rest_locals.argtypes = [P, FLOATS, ctypes.c_size_t]
-lib.tassel_frame.restype = ctypes.c_int32
-lib.tassel_frame.argtypes = [P, FLOATS, FLOATS, FLOATS, ctypes.c_size_t, ctypes.c_float]
-lib.tassel_last_error.restype = ctypes.c_char_p
+lib = tassel_abi.open_library(lib_path)
+P, FLOATS = tassel_abi.P, tassel_abi.FLOATS
 
 failures = 0
 
