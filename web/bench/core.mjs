@@ -1,7 +1,7 @@
 // The side-by-side benchmark of three-vrm's spring update and Tassel's (WebAssembly), in
 // one JavaScript process (Node: bench.mjs; Chromium: index.html): N characters of the
-// 16 x 8-joint rig with 8 colliders (rig.mjs), or of the user's file (`ctx.bytes`, Node),
-// swaying on their roots; per frame, every
+// 16 x 8-joint rig with 8 colliders (rig.mjs), or of `ctx.bytes` (the user's file in
+// Node, Tassel's built-in avatar in either), swaying on their roots; per frame, every
 // character's manager.update(1/60), or one TasselCrowd.update(1/60) for all — Tassel's
 // including the transfer of transforms from and to the three.js objects. Runs are
 // interleaved (three-vrm, Tassel three-vrm mode, Tassel fixed, the crowd in both, again...)

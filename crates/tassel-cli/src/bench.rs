@@ -89,7 +89,10 @@ impl SimdBench {
             SimdBench::Scalar => "scalar reference".into(),
             // A character's VRM springs take the scalar update where lanes would be slower.
             SimdBench::Auto => {
-                format!("lanes ({}) where they pay", Isa::of(self.simd_use()).name())
+                format!(
+                    "lanes ({}; one character's VRM springs where they pay)",
+                    Isa::of(self.simd_use()).name()
+                )
             }
             _ => format!("lanes ({})", Isa::of(self.simd_use()).name()),
         }
@@ -174,11 +177,14 @@ fn character(a: &Args) -> Result<(CharacterSim, usize, String), String> {
             Ok((
                 sim,
                 simulated,
-                if a.classic {
-                    format!("{chains} chains x {joints} joints, {colliders} colliders, chains, classic mode, 60 Hz frames")
-                } else {
-                    format!("{chains} chains x {joints} joints, {colliders} colliders, chains, fixed mode 60 Hz, one step per frame")
-                },
+                format!(
+                    "{chains} chains x {joints} joints, {colliders} colliders, chains, {}",
+                    if a.classic {
+                        "classic mode, 60 Hz frames"
+                    } else {
+                        "fixed mode 60 Hz, one step per frame"
+                    }
+                ),
             ))
         }
         Some(m) => {

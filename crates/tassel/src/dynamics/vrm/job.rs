@@ -364,7 +364,7 @@ fn lane_plan<'a>(rig: &'a VrmRig, state: &VrmState) -> Option<&'a SpringLanes> {
 
 /// Fixed mode's output step: one update of `a` (0..=1) of a step from the last step's
 /// state, on this frame's pose (`locals`, `models`: its model pose) and colliders, with
-/// the motion carried by `a` and the forces by `a(1 + a)/2` (a Verlet step of `a·h`: at
+/// the inertia and the stiffness and gravity terms all scaled by `a` (`state.carry`: at
 /// `a = 1` a whole step, at 0 the last step's tails held in place), pushed out of the
 /// colliders and limited as a step is. It writes the links' output rotations and models;
 /// the state is put back as it was. Returns whether the lane path ran (as [`update`]).

@@ -305,6 +305,19 @@ pub(crate) struct Poses<'p, T = F> {
     pub(crate) carry: (T, T),
 }
 
+impl<'p, T: Lane> Poses<'p, T> {
+    /// The poses of a whole step (carrying the motion and the forces in full).
+    #[inline(always)]
+    fn step(comp: &Trs, locals: &'p [Trs], models: &'p mut [Trs]) -> Self {
+        Poses {
+            comp: Trs::<T>::of(comp),
+            locals,
+            models,
+            carry: (T::splat(1.0), T::splat(1.0)),
+        }
+    }
+}
+
 // `match` rather than `Option::map` in the hot path: a closure is a function of its own,
 // compiled without the AVX2 code generation of the function it is called from.
 #[allow(clippy::manual_map)]
@@ -351,12 +364,7 @@ impl Ctx<'_> {
                     placed,
                     ..
                 } = s;
-                let mut poses = Poses {
-                    comp: Trs::<T>::of(&comp),
-                    locals,
-                    models,
-                    carry: (T::splat(1.0), T::splat(1.0)),
-                };
+                let mut poses = Poses::<T>::step(&comp, locals, models);
                 self.step_on(pack, &mut poses, placed, mode, M::ALL);
             }
         }
@@ -664,12 +672,7 @@ impl Ctx<'_> {
                 // Every lane's last step ends on the frame: it steps on the frame's pose
                 // itself. (Only a lane the guard resets runs an output step after it, on
                 // the reset's models; the slots this update writes are not read again.)
-                let mut poses = Poses {
-                    comp: Trs::<T>::of(&comp),
-                    locals,
-                    models,
-                    carry: (T::splat(1.0), T::splat(1.0)),
-                };
+                let mut poses = Poses::<T>::step(&comp, locals, models);
                 self.step_on(pack, &mut poses, placed, VrmMode::Fixed, active);
                 continue;
             }
@@ -692,12 +695,7 @@ impl Ctx<'_> {
                     };
                 }
             }
-            let mut poses = Poses {
-                comp: Trs::<T>::of(&comp),
-                locals: step_locals,
-                models: step_models,
-                carry: (T::splat(1.0), T::splat(1.0)),
-            };
+            let mut poses = Poses::<T>::step(&comp, step_locals, step_models);
             self.step_on(pack, &mut poses, placed, VrmMode::Fixed, active);
         }
         if !self.rig.constraints.list.is_empty() {
@@ -757,10 +755,8 @@ impl Ctx<'_> {
             ..
         } = s;
         let mut poses = Poses {
-            comp: Trs::<T>::of(&comp),
-            locals,
-            models: step_models,
             carry: (a, a),
+            ..Poses::<T>::step(&comp, locals, step_models)
         };
         self.step_on(pack, &mut poses, placed, VrmMode::Fixed, pass);
         pack.out_rotation.copy_from_slice(&pack.rotation);

@@ -12,8 +12,8 @@
 //! (each link's parent is the link before it in its column) and puts up to [`LANES`]
 //! columns with the same centre in a *group*, whatever their colliders: the group tests a
 //! list that holds each column's list in order, each entry masked to the lanes whose
-//! list it is part of, which is each lane's own list in its own order ([`Merged`]); a group's row `d` is the `d`-th link of
-//! each of its columns. A column that hangs below another column's link (a branching
+//! list it is part of, which is each lane's own list in its own order ([`Merged`]). A
+//! group's row `d` is the `d`-th link of each of its columns. A column that hangs below another column's link (a branching
 //! spring) goes to a later group ([`Group`]s are in order of that depth).
 //!
 //! **What it does not take** (the job runs the scalar update instead, [`SpringLanes::new`]
@@ -56,9 +56,10 @@ pub(crate) struct SpringLanes {
     /// writes before it reads it.
     input: Vec<usize>,
     /// Whether the lanes are worth their cost under [`SimdUse::Auto`]: at least 2.5 links
-    /// a row on average. A lane row costs about what 2.5–3 scalar links cost (measured
-    /// on the built-in avatar, 44 links in 12 rows: lanes 1.5× faster; one spring of three
-    /// links in three rows: lanes 1.3× slower).
+    /// a row on average. A lane row costs about what 2.5–3 scalar links cost (measured,
+    /// AVX-512: the built-in avatar's 44 links in 12 rows, before groups merged their
+    /// collider lists, lanes 1.5× faster than scalar; one spring of three links in three
+    /// rows, lanes 1.3× slower).
     pays: bool,
 }
 
