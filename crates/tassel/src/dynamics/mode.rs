@@ -68,14 +68,50 @@ impl SimMode {
                 };
             }
         }
-        let options = VrmOptions {
+        let options = rig.vrm.apply(VrmOptions {
             mode: match mode {
                 SimMode::Fixed => VrmMode::Fixed,
                 SimMode::ThreeVrm => VrmMode::ThreeVrm,
                 SimMode::Spec | SimMode::Classic => VrmMode::Spec,
             },
             ..VrmOptions::default()
-        };
+        });
         Ok((mode, options))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_rigs_vrm_table_sets_the_fixed_stepping() {
+        let mut rig =
+            RigSettings::from_toml_str("[vrm]\nstep_rate = 120\nmax_steps_per_frame = 3\n")
+                .unwrap();
+        let (mode, options) = SimMode::apply(None, &mut rig, true).unwrap();
+        assert_eq!(mode, SimMode::Fixed);
+        assert_eq!((options.step_rate, options.max_steps_per_frame), (120.0, 3));
+        // Without the table: VRM's own defaults.
+        let mut plain = RigSettings::default();
+        let (_, defaults) = SimMode::apply(Some(SimMode::Spec), &mut plain, true).unwrap();
+        assert_eq!(defaults.step_rate, VrmOptions::default().step_rate);
+        assert_eq!(defaults.mode, VrmMode::Spec);
+        // The table round-trips through the writer and is left out when it is default.
+        assert!(rig.to_toml_string().unwrap().contains("step_rate = 120"));
+        assert!(!plain.to_toml_string().unwrap().contains("[vrm]"));
+    }
+
+    #[test]
+    fn a_bad_vrm_table_is_refused_by_name() {
+        for (text, named) in [
+            ("[vrm]\nstep_rate = 5\n", "step_rate"),
+            ("[vrm]\nstep_rate = nan\n", "step_rate"),
+            ("[vrm]\nmax_steps_per_frame = 0\n", "max_steps_per_frame"),
+            ("[vrm]\nstep_rat = 60\n", "step_rat"),
+        ] {
+            let e = RigSettings::from_toml_str(text).unwrap_err().to_string();
+            assert!(e.contains(named), "{text:?}: {e}");
+        }
     }
 }

@@ -8,6 +8,7 @@ use crate::dynamics::chain::{
 use crate::dynamics::cloth::ClothSettings;
 use crate::dynamics::rope::RopeSettings;
 use crate::dynamics::spring::SpringSettings;
+use crate::dynamics::vrm::{VrmOptions, VrmStepping};
 use crate::error::{Error, Result};
 use crate::math::Transform;
 use crate::skeleton::Skeleton;
@@ -96,6 +97,10 @@ pub struct RigSettings {
     /// joins the tips (`bAutoAddChildDummyBoneConstraint`; default true).
     #[serde(default = "yes")]
     pub auto_add_child_dummy_bone_constraint: bool,
+    /// How `fixed` mode steps the model's VRM spring bones (`[vrm]`: `step_rate`,
+    /// `max_steps_per_frame`).
+    #[serde(default, skip_serializing_if = "VrmStepping::is_default")]
+    pub vrm: VrmStepping,
     /// Bone chains (`[[chain]]` tables).
     #[serde(default, rename = "chain")]
     pub chains: Vec<ChainSettings>,
@@ -148,6 +153,7 @@ impl Default for RigSettings {
             bone_constraint_iteration_count_before_collision: 0,
             bone_constraint_iteration_count_after_collision: 1,
             auto_add_child_dummy_bone_constraint: true,
+            vrm: VrmStepping::default(),
             chains: Vec::new(),
             colliders: Vec::new(),
             springs: Vec::new(),
@@ -195,6 +201,7 @@ impl RigSettings {
                 self.colliders.len()
             )));
         }
+        self.vrm.apply(VrmOptions::default()).validate()?;
         // Name sets, not scans: every check below is linear in the rig's size.
         let mut colliders = std::collections::HashSet::with_capacity(self.colliders.len());
         for col in &self.colliders {

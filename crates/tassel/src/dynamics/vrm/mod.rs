@@ -69,5 +69,5 @@ pub use job::{VrmJob, VrmState};
 pub use limit::{axis_rotation, LinkLimit, VrmLimit, VrmLimitShape};
 pub use settings::{
     VrmCollider, VrmColliderGroup, VrmJoint, VrmMode, VrmOptions, VrmShape, VrmSpring,
-    VrmSpringBones, VrmTail,
+    VrmSpringBones, VrmStepping, VrmTail,
 };

@@ -414,3 +414,41 @@ impl VrmOptions {
         Ok(())
     }
 }
+
+/// A rig file's `[vrm]` table: how `fixed` mode steps the character's VRM spring bones
+/// (the mode itself is chosen by `--mode`, not the file). Rig chains step at their own
+/// `target_framerate`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct VrmStepping {
+    /// Internal steps per second (10..=1000; default 60).
+    pub step_rate: f32,
+    /// At most this many steps in one frame; a longer hitch drops time (default 8).
+    pub max_steps_per_frame: u32,
+}
+
+impl Default for VrmStepping {
+    fn default() -> Self {
+        let o = VrmOptions::default();
+        Self {
+            step_rate: o.step_rate,
+            max_steps_per_frame: o.max_steps_per_frame,
+        }
+    }
+}
+
+impl VrmStepping {
+    /// Whether every field has its default (the table is then not written).
+    pub fn is_default(&self) -> bool {
+        *self == Self::default()
+    }
+
+    /// `options` with this stepping.
+    pub fn apply(&self, options: VrmOptions) -> VrmOptions {
+        VrmOptions {
+            step_rate: self.step_rate,
+            max_steps_per_frame: self.max_steps_per_frame,
+            ..options
+        }
+    }
+}

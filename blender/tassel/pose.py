@@ -1,0 +1,121 @@
+"""An armature as Tassel sees it, and the pose through it both ways (numpy, no bpy).
+
+Tassel's world is glTF's (+Y up); Blender's is +Z up. The character's root transform is
+`TO_TASSEL @ object.matrix_world`, so a bone's local transforms, rest or posed, are
+Blender's own numbers: a rig file's offsets are in the bone's frame, as Blender's glTF
+importer keeps it (bone frame = node frame), and gravity [0, -9.81, 0] points down the
+scene's -Z. Transforms for Tassel are 10 floats: tx ty tz qx qy qz qw sx sy sz.
+"""
+import numpy as np
+
+# Blender world (x, y, z) -> Tassel's (x, z, -y): a quarter turn about +X.
+TO_TASSEL = np.array(
+    [[1.0, 0.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0], [0.0, -1.0, 0.0, 0.0], [0.0, 0.0, 0.0, 1.0]]
+)
+
+
+def quats_from_matrices(r):
+    """Unit quaternions (x, y, z, w) of rotation matrices r (n × 3 × 3)."""
+    m00, m01, m02 = r[:, 0, 0], r[:, 0, 1], r[:, 0, 2]
+    m10, m11, m12 = r[:, 1, 0], r[:, 1, 1], r[:, 1, 2]
+    m20, m21, m22 = r[:, 2, 0], r[:, 2, 1], r[:, 2, 2]
+    squares = np.stack(
+        [1 + m00 - m11 - m22, 1 - m00 + m11 - m22, 1 - m00 - m11 + m22, 1 + m00 + m11 + m22], axis=1
+    )
+    pick = np.argmax(squares, axis=1)
+    big = 0.5 * np.sqrt(np.maximum(squares[np.arange(len(r)), pick], 1e-30))
+    inv = 0.25 / big
+    q = np.empty((len(r), 4))
+    # Each row from its largest component (the stable one), as Shepperd's method.
+    cases = [
+        (big, (m01 + m10) * inv, (m02 + m20) * inv, (m21 - m12) * inv),
+        ((m01 + m10) * inv, big, (m12 + m21) * inv, (m02 - m20) * inv),
+        ((m02 + m20) * inv, (m12 + m21) * inv, big, (m10 - m01) * inv),
+        ((m21 - m12) * inv, (m02 - m20) * inv, (m10 - m01) * inv, big),
+    ]
+    for k, (x, y, z, w) in enumerate(cases):
+        rows = pick == k
+        q[rows] = np.stack([x[rows], y[rows], z[rows], w[rows]], axis=1)
+    return q / np.linalg.norm(q, axis=1, keepdims=True)
+
+
+def matrices_from_quats(q):
+    """Rotation matrices (n × 3 × 3) of quaternions q (n × 4, x y z w)."""
+    x, y, z, w = q[:, 0], q[:, 1], q[:, 2], q[:, 3]
+    r = np.empty((len(q), 3, 3))
+    r[:, 0, 0] = 1 - 2 * (y * y + z * z)
+    r[:, 0, 1] = 2 * (x * y - z * w)
+    r[:, 0, 2] = 2 * (x * z + y * w)
+    r[:, 1, 0] = 2 * (x * y + z * w)
+    r[:, 1, 1] = 1 - 2 * (x * x + z * z)
+    r[:, 1, 2] = 2 * (y * z - x * w)
+    r[:, 2, 0] = 2 * (x * z - y * w)
+    r[:, 2, 1] = 2 * (y * z + x * w)
+    r[:, 2, 2] = 1 - 2 * (x * x + y * y)
+    return r
+
+
+def transforms_from_matrices(m):
+    """n × 10 transforms from affine matrices m (n × 4 × 4); shear is dropped, a mirror
+    goes into the x scale."""
+    lin = m[:, :3, :3]
+    scale = np.linalg.norm(lin, axis=1)
+    scale = np.where(scale > 1e-12, scale, 1e-12)
+    rot = lin / scale[:, None, :]
+    mirrored = np.linalg.det(rot) < 0
+    scale[mirrored, 0] *= -1
+    rot[mirrored, :, 0] *= -1
+    out = np.empty((len(m), 10))
+    out[:, 0:3] = m[:, :3, 3]
+    out[:, 3:7] = quats_from_matrices(rot)
+    out[:, 7:10] = scale
+    return out
+
+
+def matrices_from_transforms(t):
+    """Affine matrices (n × 4 × 4) of n × 10 transforms."""
+    q = t[:, 3:7] / np.linalg.norm(t[:, 3:7], axis=1, keepdims=True)
+    m = np.zeros((len(t), 4, 4))
+    m[:, :3, :3] = matrices_from_quats(q) * t[:, None, 7:10]
+    m[:, :3, 3] = t[:, 0:3]
+    m[:, 3, 3] = 1.0
+    return m
+
+
+class Skeleton:
+    """An armature's bones as Tassel joints, in the armature's bone order.
+
+    `names`, `parents` (-1 for a root) and `rest_matrices` (n × 4 × 4, each bone's
+    `matrix_local`: armature space) come from bpy in `from_armature`."""
+
+    def __init__(self, names, parents, rest_matrices):
+        self.names = list(names)
+        self.parents = np.asarray(parents, dtype=np.intp)
+        self.rest_matrices = np.asarray(rest_matrices, dtype=np.float64).reshape(-1, 4, 4)
+        self.has_parent = self.parents >= 0
+        self.rest_local_matrices = self.locals_of(self.rest_matrices)
+        self.rest_local_inverses = np.linalg.inv(self.rest_local_matrices)
+        self.rest = transforms_from_matrices(self.rest_local_matrices)
+
+    def locals_of(self, armature_matrices):
+        """Local matrices (relative to the parent bone) of armature-space matrices."""
+        local = armature_matrices.copy()
+        kids = self.has_parent
+        local[kids] = np.linalg.inv(armature_matrices[self.parents[kids]]) @ armature_matrices[kids]
+        return local
+
+    def pose_locals(self, pose_matrices):
+        """n × 10 local transforms of an evaluated pose (`pose.bones[i].matrix`, n × 4 × 4)."""
+        return transforms_from_matrices(self.locals_of(pose_matrices))
+
+    def bases_of(self, locals10, joints=None):
+        """Pose-bone `matrix_basis` (× 4 × 4) giving the local transforms `locals10` of
+        `joints` (default: every bone): local = rest_local @ basis (bones that inherit
+        rotation and scale, as by default)."""
+        inverses = self.rest_local_inverses if joints is None else self.rest_local_inverses[joints]
+        return inverses @ matrices_from_transforms(np.asarray(locals10, dtype=np.float64))
+
+
+def root_transform(object_world):
+    """The character's root for Tassel (10 floats) from the object's matrix_world (4 × 4)."""
+    return transforms_from_matrices((TO_TASSEL @ np.asarray(object_world, dtype=np.float64))[None])[0]
