@@ -82,6 +82,29 @@ def matrices_from_transforms(t):
     return m
 
 
+def affine_inverses(m):
+    """Inverses of affine matrices m (… × 4 × 4) by the 3 × 3 adjugate: one batch of
+    arithmetic, where numpy's general inverse pays per matrix."""
+    a = m[..., :3, :3]
+    cof = np.empty_like(a)
+    cof[..., 0, 0] = a[..., 1, 1] * a[..., 2, 2] - a[..., 1, 2] * a[..., 2, 1]
+    cof[..., 0, 1] = a[..., 0, 2] * a[..., 2, 1] - a[..., 0, 1] * a[..., 2, 2]
+    cof[..., 0, 2] = a[..., 0, 1] * a[..., 1, 2] - a[..., 0, 2] * a[..., 1, 1]
+    cof[..., 1, 0] = a[..., 1, 2] * a[..., 2, 0] - a[..., 1, 0] * a[..., 2, 2]
+    cof[..., 1, 1] = a[..., 0, 0] * a[..., 2, 2] - a[..., 0, 2] * a[..., 2, 0]
+    cof[..., 1, 2] = a[..., 0, 2] * a[..., 1, 0] - a[..., 0, 0] * a[..., 1, 2]
+    cof[..., 2, 0] = a[..., 1, 0] * a[..., 2, 1] - a[..., 1, 1] * a[..., 2, 0]
+    cof[..., 2, 1] = a[..., 0, 1] * a[..., 2, 0] - a[..., 0, 0] * a[..., 2, 1]
+    cof[..., 2, 2] = a[..., 0, 0] * a[..., 1, 1] - a[..., 0, 1] * a[..., 1, 0]
+    det = np.einsum("...j,...j->...", a[..., 0, :], cof[..., :, 0])
+    det = np.where(np.abs(det) > 1e-30, det, 1e-30)
+    out = np.zeros_like(m)
+    out[..., :3, :3] = cof / det[..., None, None]
+    out[..., :3, 3] = -np.einsum("...ij,...j->...i", out[..., :3, :3], m[..., :3, 3])
+    out[..., 3, 3] = 1.0
+    return out
+
+
 class Skeleton:
     """An armature's bones as Tassel joints, in the armature's bone order.
 
@@ -94,19 +117,23 @@ class Skeleton:
         self.rest_matrices = np.asarray(rest_matrices, dtype=np.float64).reshape(-1, 4, 4)
         self.has_parent = self.parents >= 0
         self.rest_local_matrices = self.locals_of(self.rest_matrices)
-        self.rest_local_inverses = np.linalg.inv(self.rest_local_matrices)
+        self.rest_local_inverses = affine_inverses(self.rest_local_matrices)
         self.rest = transforms_from_matrices(self.rest_local_matrices)
 
     def locals_of(self, armature_matrices):
-        """Local matrices (relative to the parent bone) of armature-space matrices."""
-        local = armature_matrices.copy()
-        kids = self.has_parent
-        local[kids] = np.linalg.inv(armature_matrices[self.parents[kids]]) @ armature_matrices[kids]
+        """Local matrices (relative to the parent bone) of armature-space matrices
+        (… × n × 4 × 4: one pose, or many frames of poses)."""
+        m = armature_matrices
+        local = m.copy()
+        kids = np.nonzero(self.has_parent)[0]
+        local[..., kids, :, :] = affine_inverses(m[..., self.parents[kids], :, :]) @ m[..., kids, :, :]
         return local
 
     def pose_locals(self, pose_matrices):
-        """n × 10 local transforms of an evaluated pose (`pose.bones[i].matrix`, n × 4 × 4)."""
-        return transforms_from_matrices(self.locals_of(pose_matrices))
+        """Local transforms (… × n × 10) of evaluated poses (`pose.bones[i].matrix`,
+        … × n × 4 × 4)."""
+        local = self.locals_of(pose_matrices)
+        return transforms_from_matrices(local.reshape(-1, 4, 4)).reshape(local.shape[:-2] + (10,))
 
     def bases_of(self, locals10, joints=None):
         """Pose-bone `matrix_basis` (× 4 × 4) giving the local transforms `locals10` of

@@ -4,6 +4,7 @@ the scene's range resets the solvers; the next frame steps 1/fps; any other jump
 teleports (the solvers start again from the pose there)."""
 import bpy
 from bpy.app.handlers import persistent
+from mathutils import Matrix
 
 from . import bake, character
 
@@ -13,10 +14,22 @@ _live = {}
 
 
 def invalidate(_self=None, _context=None):
-    """Forget every preview's state (a setting changed): the next frame starts again."""
-    for state in _live.values():
+    """Forget every preview's state (a setting changed, the preview was switched off):
+    the simulated bones get their own transforms back and the next frame starts again."""
+    for key, state in _live.items():
+        armature = bpy.data.objects.get(key)
+        if armature is not None and state["saved"] is not None:
+            _restore(armature, state)
         state["stepper"].character.close()
     _live.clear()
+
+
+def _restore(armature, state):
+    for name, basis in zip(state["bones"], state["saved"]):
+        bone = armature.pose.bones.get(name)
+        if bone is not None:
+            bone.matrix_basis = basis
+    state["saved"] = None
 
 
 def _state(armature):
@@ -41,8 +54,7 @@ def before_frame(scene, _depsgraph=None):
     for armature in _armatures(scene):
         state = _live.get(armature.name)
         if state and state["saved"] is not None:
-            for name, basis in zip(state["bones"], state["saved"]):
-                armature.pose.bones[name].matrix_basis = basis
+            _restore(armature, state)
 
 
 @persistent
@@ -75,7 +87,7 @@ def after_frame(scene, depsgraph=None):
         bones = armature.pose.bones
         state["saved"] = [bones[name].matrix_basis.copy() for name in state["bones"]]
         for name, basis in zip(state["bones"], bases):
-            bones[name].matrix_basis = [list(r) for r in basis]
+            bones[name].matrix_basis = Matrix(basis.tolist())
 
 
 def register():
