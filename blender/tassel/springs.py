@@ -159,8 +159,8 @@ def _vrm0(armature, secondary, bone_index):
             # VRM 0.x offset with z negated (Unity's axes), so z is written negated.
             at = bone_inverse @ world_inverse @ np.array(empty.matrix_world)[:, 3]
             scale = float(np.mean(np.abs(np.array(empty.matrix_world.to_scale()))))
-            colliders.append({"offset": {"x": at[0], "y": at[1], "z": -at[2]},
-                              "radius": empty.empty_display_size * scale})
+            colliders.append({"offset": {"x": float(at[0]), "y": float(at[1]), "z": -float(at[2])},
+                              "radius": float(empty.empty_display_size) * scale})
         group_by_uuid[g.uuid] = len(groups)
         groups.append({"node": node, "colliders": colliders})
     bone_groups = []
