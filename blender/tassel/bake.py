@@ -28,7 +28,8 @@ class Stepper:
         """One frame on the armature as `depsgraph` evaluates it; dt = 0 after a reset places."""
         evaluated = armature.evaluated_get(depsgraph)
         matrices = character.read_pose(evaluated, self.order, self.buffer)
-        self.locals_in[:] = self.skeleton.pose_locals(matrices)
+        bases = character.read_pose(evaluated, self.order, self.buffer, "matrix_basis")
+        self.locals_in[:] = self.skeleton.pose_locals(matrices, bases)
         root = pose.root_transform(np.array(evaluated.matrix_world))
         self.character.frame(root, self.locals_in, self.locals_out, dt)
         return self.locals_out
@@ -50,6 +51,7 @@ def simulate(context, armature, mode, frame_start, frame_end, step_rate, report_
     frames = frame_end - frame_start + 1
     dt = scene.render.fps_base / scene.render.fps
     matrices = np.empty((frames, n, 4, 4))
+    bases = np.empty((frames, n, 4, 4))
     worlds = np.empty((frames, 4, 4))
     current = scene.frame_current
     try:
@@ -57,20 +59,24 @@ def simulate(context, armature, mode, frame_start, frame_end, step_rate, report_
             scene.frame_set(frame_start + k)
             evaluated = armature.evaluated_get(context.evaluated_depsgraph_get())
             matrices[k] = character.read_pose(evaluated, stepper.order, stepper.buffer)
+            bases[k] = character.read_pose(evaluated, stepper.order, stepper.buffer, "matrix_basis")
             worlds[k] = np.array(evaluated.matrix_world)
             if report_progress:
                 report_progress(k + 1, 2 * frames)
     finally:
         scene.frame_set(current)
-    animated = skeleton.pose_locals(matrices).astype(np.float32)
+    animated = skeleton.pose_locals(matrices, bases).astype(np.float32)
     roots = pose.transforms_from_matrices(pose.TO_TASSEL[None] @ worlds)
     out = np.empty((frames, n, 10), dtype=np.float32)
     # The character was made at the rest pose at the origin of glTF's axes: the first
     # frame places every solver on this pose and place instead of swinging from there.
     stepper.character.reset()
     for k in range(frames):
-        stepper.character.frame(roots[k], animated[k], out[k], 0.0 if k == 0 else dt)
-        if report_progress and ((k + 1) % 64 == 0 or k + 1 == frames):
+        try:
+            stepper.character.frame(roots[k], animated[k], out[k], 0.0 if k == 0 else dt)
+        except character.native.TasselError as e:
+            raise character.native.TasselError(f"frame {frame_start + k}: {e}") from None
+        if report_progress:
             report_progress(frames + k + 1, 2 * frames)
     return skeleton, stepper.character.simulated, out
 

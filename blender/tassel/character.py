@@ -86,10 +86,11 @@ def make(armature, mode="FIXED", step_rate=DEFAULT_STEP_RATE):
     return character, skeleton
 
 
-def read_pose(evaluated, order, buffer):
-    """The evaluated armature's pose matrices (armature space) in the skeleton's bone order:
-    `order[i]` is bone i's index among `pose.bones`; `buffer` is scratch (n × 16 float32)."""
-    evaluated.pose.bones.foreach_get("matrix", buffer.reshape(-1))
+def read_pose(evaluated, order, buffer, which="matrix"):
+    """The evaluated armature's pose matrices (`which`: "matrix", armature space, or
+    "matrix_basis") in the skeleton's bone order: `order[i]` is bone i's index among
+    `pose.bones`; `buffer` is scratch (n × 16 float32)."""
+    evaluated.pose.bones.foreach_get(which, buffer.reshape(-1))
     # bpy lays matrices out column by column.
     return buffer.reshape(-1, 4, 4).transpose(0, 2, 1)[order].astype(np.float64)
 

@@ -60,8 +60,17 @@ def transforms_from_matrices(m):
     goes into the x scale."""
     lin = m[:, :3, :3]
     scale = np.linalg.norm(lin, axis=1)
-    scale = np.where(scale > 1e-12, scale, 1e-12)
-    rot = lin / scale[:, None, :]
+    flat = scale <= 1e-12
+    rot = lin / np.where(flat, 1.0, scale)[:, None, :]
+    # An axis scaled to nothing: the other two still give the rotation (their cross
+    # product stands in for it); with two or three gone, no rotation is left (identity).
+    for axis in range(3):
+        rows = flat[:, axis] & (flat.sum(axis=1) == 1)
+        a, b = (axis + 1) % 3, (axis + 2) % 3
+        rot[rows, :, axis] = np.cross(rot[rows, :, a], rot[rows, :, b])
+    lost = flat.sum(axis=1) >= 2
+    rot[lost] = np.eye(3)
+    scale = np.where(flat, 0.0, scale)
     mirrored = np.linalg.det(rot) < 0
     scale[mirrored, 0] *= -1
     rot[mirrored, :, 0] *= -1
@@ -129,11 +138,32 @@ class Skeleton:
         local[..., kids, :, :] = affine_inverses(m[..., self.parents[kids], :, :]) @ m[..., kids, :, :]
         return local
 
-    def pose_locals(self, pose_matrices):
+    def pose_locals(self, pose_matrices, bases=None):
         """Local transforms (… × n × 10) of evaluated poses (`pose.bones[i].matrix`,
-        … × n × 4 × 4)."""
+        … × n × 4 × 4). Where a matrix cannot be taken apart — a bone scaled to nothing
+        (animators hide parts so), or a bone under one — and `bases` (the pose bones'
+        `matrix_basis`, the same shape) is given, that bone's local transform is
+        `rest_local @ basis` instead: the animation's own value, without constraints
+        (a bone scaled to nothing on two or three axes keeps no rotation: identity)."""
         local = self.locals_of(pose_matrices)
-        return transforms_from_matrices(local.reshape(-1, 4, 4)).reshape(local.shape[:-2] + (10,))
+        out = transforms_from_matrices(local.reshape(-1, 4, 4)).reshape(local.shape[:-2] + (10,))
+        if bases is None:
+            return out
+        det = np.abs(np.linalg.det(pose_matrices[..., :3, :3]))
+        flat = np.max(np.abs(pose_matrices[..., :3, :3]), axis=(-1, -2))
+        degenerate = det <= 1e-9 * np.maximum(flat, 1e-30) ** 3
+        bad = degenerate.copy()
+        bad[..., self.has_parent] |= degenerate[..., self.parents[self.has_parent]]
+        if not bad.any():
+            return out
+        basis = transforms_from_matrices(bases[bad])
+        scale = basis[:, 7:10].copy()
+        basis[:, 7:10] = 1.0
+        rest = np.broadcast_to(self.rest_local_matrices, local.shape)[bad]
+        fixed = transforms_from_matrices(rest @ matrices_from_transforms(basis))
+        fixed[:, 7:10] = scale
+        out[bad] = fixed
+        return out
 
     def bases_of(self, locals10, joints=None):
         """Pose-bone `matrix_basis` (× 4 × 4) giving the local transforms `locals10` of

@@ -34,4 +34,13 @@ for test in test_pose test_fox test_vrm test_vrm0 test_bad_input test_preview; d
     exit 1
   fi
   grep -E '^OK' "$log"
+  # Headless, a bake says how far it is on the console, a line per 10 %.
+  if [ "$test" = test_fox ]; then
+    lines=$(grep -c "^Tassel: baking 'root' frames 0–120: " "$log" || true)
+    if [ "$lines" -lt 10 ] || ! grep -q "^Tassel: baking 'root' frames 0–120: 100 %" "$log"; then
+      echo "error: the headless bake printed $lines progress lines, not one per 10 % ending at 100 %" >&2
+      exit 1
+    fi
+    echo "OK the headless bake printed $lines progress lines, the last at 100 %"
+  fi
 done

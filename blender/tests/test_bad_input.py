@@ -69,6 +69,32 @@ fox.tassel.rig_text = None
 refused("no rig", "has no rig", frame_start=1, frame_end=40)
 fox.tassel.rig_file = "/nonexistent/fox.toml"
 refused("a rig file that does not exist", "/nonexistent/fox.toml", frame_start=1, frame_end=40)
+# Not bad input: a bone scaled to nothing (how animators hide parts) bakes; its subtree
+# sits collapsed on its head, every key finite.
+text.from_string(good)
+fox.tassel.rig_file = ""
+fox.tassel.rig_text = text
+hidden = run.copy()
+fox.animation_data.action = hidden
+hip = fox.pose.bones["b_Hip_01"]
+for frame, s in ((4, 1.0), (5, 0.0), (6, 0.0), (7, 1.0)):
+    hip.scale = (s, s, s)
+    hip.keyframe_insert("scale", frame=frame)
+scene.frame_set(1)
+assert bpy.ops.tassel.bake(frame_start=1, frame_end=10) == {"FINISHED"}
+import math  # noqa: E402
+keys = [k.co[1] for bag in fox.animation_data.action.layers[0].strips[0].channelbags
+        for fc in bag.fcurves for k in fc.keyframe_points]
+if not all(math.isfinite(v) for v in keys):
+    helpers.fail("a bake through a bone scaled to nothing wrote a key that is not finite")
+scene.frame_set(5)
+head = fox.matrix_world @ hip.head
+tip = fox.matrix_world @ fox.pose.bones["b_Tail03_014"].tail
+if (tip - head).length > 1e-3:
+    helpers.fail(f"under a hip scaled to nothing the tail's tip is {(tip - head).length} from the hip")
+scene.frame_set(9)
+print(f"OK a hip scaled to nothing on frames 5–6 bakes: {len(keys)} finite keys, the tail collapsed on it")
+fox.animation_data.action = run
 # And the good rig still bakes after all that.
 fox.tassel.rig_file = ""
 fox.tassel.rig_text = text

@@ -24,6 +24,8 @@ FRAMES = 120
 TOLERANCE = 0.01  # 1e-4 m in the fox's centimetre units
 
 helpers.fresh_blender(sys.argv[-1])
+if getattr(bpy.types, "TASSEL_PT_armature", None) is None or bpy.types.TASSEL_PT_armature.bl_context != "data":
+    helpers.fail("the panel is not registered on the armature's Object Data tab")
 scene = bpy.context.scene
 scene.render.fps, scene.render.fps_base = FPS, 1.0
 

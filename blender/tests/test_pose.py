@@ -78,3 +78,29 @@ frames = skel.pose_locals(np.stack([rest, posed]))
 check("many frames at once = one by one", np.allclose(frames[1], local) and np.allclose(frames[0], skel.rest))
 bases = skel.bases_of(local)
 check("rest_local · basis = local", np.allclose(skel.rest_local_matrices @ bases, pose.matrices_from_transforms(local)))
+
+# A bone scaled to nothing: its matrix and its children's cannot be taken apart; with the
+# pose bones' bases given, their locals are rest_local @ basis (the basis's rotation, the
+# zero scale kept), and the others are untouched.
+turn = pose.matrices_from_quats(np.array([[0, 0, math.sin(0.2), math.cos(0.2)]]))[0]
+bases = np.stack([np.eye(4)] * 3)
+bases[1, :3, :3] = turn * 0.0  # b: turned 0.4 rad, then scaled to nothing
+bases[2, :3, :3] = turn       # c: turned 0.4 rad
+collapsed = rest.copy()
+collapsed[1, :3, :3] = 0.0
+collapsed[2, :3, :3] = 0.0
+collapsed[2, :3, 3] = collapsed[1, :3, 3]
+fixed = skel.pose_locals(collapsed, bases)
+plain = skel.pose_locals(collapsed)
+check("a bone scaled to nothing: scale 0 from its basis, a unit rotation",
+      np.allclose(fixed[1, 7:10], 0) and abs(np.linalg.norm(fixed[1, 3:7]) - 1) < 1e-12)
+check("its child's local from its basis, not from the collapsed matrices",
+      np.allclose(fixed[2, 3:7], [0, 0, math.sin(0.2), math.cos(0.2)]) and np.allclose(fixed[2, 0:3], [0, 1, 0])
+      and not np.allclose(plain[2, 0:3], [0, 1, 0]))
+check("the bones above it untouched", np.allclose(fixed[0], skel.rest[0]))
+# Flattened on one axis only: the rotation survives (the other two axes give it).
+flat = np.zeros((1, 10))
+flat[0, 3:7] = [0, 0, math.sin(0.2), math.cos(0.2)]
+flat[0, 7:10] = [1.0, 0.0, 2.0]
+back = pose.transforms_from_matrices(pose.matrices_from_transforms(flat))
+check("one axis scaled to nothing keeps the rotation", np.allclose(back, flat))
