@@ -12,6 +12,21 @@ _P = ctypes.c_void_p
 _FLOATS = ctypes.POINTER(ctypes.c_float)
 _SIZES = ctypes.POINTER(ctypes.c_size_t)
 
+# The functions used here: (return type, argument types), as tassel.h declares them.
+_SIGNATURES = {
+    "tassel_character_new": (_P, [ctypes.POINTER(ctypes.c_char_p), ctypes.POINTER(ctypes.c_int32), _FLOATS,
+                                  ctypes.c_size_t, ctypes.c_char_p, ctypes.c_char_p, ctypes.c_char_p]),
+    "tassel_character_free": (None, [_P]),
+    "tassel_frame": (ctypes.c_int32, [_P, _FLOATS, _FLOATS, _FLOATS, ctypes.c_size_t, ctypes.c_float]),
+    "tassel_reset": (None, [_P]),
+    "tassel_teleport": (None, [_P]),
+    "tassel_simulated_joint_count": (ctypes.c_size_t, [_P]),
+    "tassel_simulated_joints": (ctypes.c_int32, [_P, _SIZES, ctypes.c_size_t]),
+    "tassel_mode": (ctypes.c_char_p, [_P]),
+    "tassel_last_error": (ctypes.c_char_p, []),
+    "tassel_version": (ctypes.c_char_p, []),
+}
+
 _LIBRARY_NAMES = {"linux": "libtassel_ffi.so", "darwin": "libtassel_ffi.dylib", "win32": "tassel_ffi.dll"}
 
 
@@ -40,24 +55,9 @@ def library():
     if not os.path.exists(path):
         raise TasselError(f"Tassel's native library is missing: {path} (build the extension with blender/build.sh)")
     lib = ctypes.CDLL(path)
-    lib.tassel_character_new.restype = _P
-    lib.tassel_character_new.argtypes = [
-        ctypes.POINTER(ctypes.c_char_p), ctypes.POINTER(ctypes.c_int32), _FLOATS, ctypes.c_size_t,
-        ctypes.c_char_p, ctypes.c_char_p, ctypes.c_char_p,
-    ]
-    lib.tassel_character_free.argtypes = [_P]
-    lib.tassel_frame.restype = ctypes.c_int32
-    lib.tassel_frame.argtypes = [_P, _FLOATS, _FLOATS, _FLOATS, ctypes.c_size_t, ctypes.c_float]
-    lib.tassel_reset.argtypes = [_P]
-    lib.tassel_teleport.argtypes = [_P]
-    lib.tassel_simulated_joint_count.restype = ctypes.c_size_t
-    lib.tassel_simulated_joint_count.argtypes = [_P]
-    lib.tassel_simulated_joints.restype = ctypes.c_int32
-    lib.tassel_simulated_joints.argtypes = [_P, _SIZES, ctypes.c_size_t]
-    lib.tassel_mode.restype = ctypes.c_char_p
-    lib.tassel_mode.argtypes = [_P]
-    lib.tassel_last_error.restype = ctypes.c_char_p
-    lib.tassel_version.restype = ctypes.c_char_p
+    for name, (restype, argtypes) in _SIGNATURES.items():
+        function = getattr(lib, name)
+        function.restype, function.argtypes = restype, argtypes
     _lib = lib
     return lib
 
