@@ -2,7 +2,7 @@
 //! rig ([`CrowdKind::of`]), with the characters' animated input and the simulated output in
 //! flat buffers, one slot per character.
 
-use crate::step::{to_bevy, to_tassel, world_of};
+use crate::convert::{to_bevy, to_tassel, world_of};
 use bevy::ecs::prelude::*;
 use bevy::platform::collections::{HashMap, HashSet};
 use bevy::prelude::{ChildOf, Transform as BevyTransform};

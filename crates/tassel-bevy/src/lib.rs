@@ -47,6 +47,7 @@ mod assets;
 mod bind;
 mod character;
 mod controller;
+mod convert;
 mod crowd;
 #[cfg(feature = "gizmos")]
 mod gizmos;

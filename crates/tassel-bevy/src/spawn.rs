@@ -1,6 +1,6 @@
 //! A skeleton made in code (or read by `tassel_gltf`) spawned as Bevy entities.
 
-use crate::step::to_bevy;
+use crate::convert::to_bevy;
 use bevy::ecs::prelude::*;
 use bevy::prelude::{ChildOf, Name};
 use tassel::Skeleton;

@@ -2,7 +2,7 @@
 
 use crate::output::{check_output_dir, write_atomic};
 use crate::progress::Progress;
-use crate::simulate::Mode;
+use crate::subject::Mode;
 use crate::subject::{make_sim, rig_or_vrm, SwayArgs};
 use std::path::PathBuf;
 use tassel::CharacterSim;

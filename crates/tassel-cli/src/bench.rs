@@ -1,7 +1,7 @@
 //! `tassel bench [FILE]`: ns per joint-step and µs per frame, for a synthetic character
 //! (16 strands of 8 joints, 8 colliders) or the user's own file.
 
-use crate::simulate::Mode;
+use crate::subject::Mode;
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Instant;

@@ -2,7 +2,7 @@
 //! mode and frame rate, for the same motion.
 
 use crate::output::{check_output_dir, write_atomic};
-use crate::simulate::Mode;
+use crate::subject::Mode;
 use crate::subject::{SubjectArgs, SwayArgs};
 use std::path::PathBuf;
 use tassel_gltf::{key_times, play, BakeOptions};

@@ -1,13 +1,57 @@
 //! The character a command works on: a file (its skeleton, clips and VRM springs) or the
 //! embedded one, with the rig that drives its secondary motion.
 
-use crate::simulate::{read_rig, Mode};
 use std::path::{Path, PathBuf};
 use tassel::anim::Clip;
 use tassel::dynamics::vrm::VrmSpringBones;
 use tassel::dynamics::{RigSettings, SimMode};
 use tassel::{builtin, CharacterSim, Skeleton};
 use tassel_gltf::Sway;
+
+/// `--mode` on the command line.
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Mode {
+    Spec,
+    Fixed,
+    Classic,
+    /// VRM springs as three-vrm 3.5.5 runs them in a web app.
+    ThreeVrm,
+}
+
+impl From<Mode> for SimMode {
+    fn from(m: Mode) -> SimMode {
+        match m {
+            Mode::Spec => SimMode::Spec,
+            Mode::Fixed => SimMode::Fixed,
+            Mode::Classic => SimMode::Classic,
+            Mode::ThreeVrm => SimMode::ThreeVrm,
+        }
+    }
+}
+
+/// The largest rig file read (16 MiB: far beyond any real rig, far below any memory
+/// trouble).
+pub const MAX_RIG_BYTES: u64 = 16 << 20;
+
+pub fn read_rig(path: &PathBuf) -> Result<RigSettings, String> {
+    use std::io::Read;
+    let fail = |e: std::io::Error| format!("{}: {e}", path.display());
+    let file = std::fs::File::open(path).map_err(fail)?;
+    if !file.metadata().map_err(fail)?.is_file() {
+        return Err(format!("{}: not a regular file", path.display()));
+    }
+    let mut text = String::new();
+    file.take(MAX_RIG_BYTES + 1)
+        .read_to_string(&mut text)
+        .map_err(fail)?;
+    if text.len() as u64 > MAX_RIG_BYTES {
+        return Err(format!(
+            "{}: the rig file is larger than the limit of {MAX_RIG_BYTES} bytes",
+            path.display()
+        ));
+    }
+    RigSettings::from_toml_str(&text).map_err(|e| format!("{}: {e}", path.display()))
+}
 
 pub struct Subject {
     /// For titles and messages.

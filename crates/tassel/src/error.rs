@@ -9,7 +9,7 @@ pub enum Error {
     #[error("skeleton has no joints")]
     EmptySkeleton,
     /// More joints than the `u16` parent indices can hold.
-    #[error("skeleton has {0} joints; at most {max} are supported", max = crate::skeleton::MAX_JOINTS)]
+    #[error("skeleton has {0} joints; at most {max} are supported", max = crate::limits::MAX_JOINTS)]
     TooManyJoints(usize),
     /// Two joints share a name.
     #[error("duplicate joint name '{0}'")]

@@ -3,8 +3,9 @@
 //! file, a rig or an argument cannot ask for gigabytes or hours. Going past one is an
 //! error that names the entry and the limit, never a hang, an abort or a panic.
 
-/// The most joints (glTF nodes) one skeleton may hold.
-pub const MAX_JOINTS: usize = crate::skeleton::MAX_JOINTS;
+/// The most joints (glTF nodes) one skeleton may hold (parents are `u16`, with
+/// `u16::MAX` for none).
+pub const MAX_JOINTS: usize = 16_384;
 
 /// The latest key time of a clip, seconds (one hour). A bake or a render of a clip plays
 /// every frame of it, so this bounds their work.

@@ -7,8 +7,7 @@ use std::collections::HashMap;
 
 /// Marks a joint without parent.
 pub const NO_PARENT: u16 = u16::MAX;
-/// The largest number of joints a skeleton may hold.
-pub const MAX_JOINTS: usize = 16_384;
+pub use crate::limits::MAX_JOINTS;
 
 /// Joints in depth-first order. Build it with [`Skeleton::new`] (already ordered) or
 /// [`SkeletonBuilder`] (any order, sorted for you).
