@@ -26,7 +26,7 @@ py="$venv/bin/python"
 # Blender's own extension validator (what `blender --command extension validate` runs).
 "$py" "$("$py" -c 'import bpy, os; print(os.path.join(bpy.utils.system_resource("SCRIPTS"), "addons_core", "bl_pkg", "cli", "blender_ext.py"))' 2>/dev/null | tail -n 1)" validate "$zip"
 log=target/blender-test.log
-for test in test_pose test_fox test_vrm test_vrm0 test_bad_input test_preview; do
+for test in test_pose test_fox test_vrm test_vrm0 test_sources test_bad_input test_preview; do
   echo "== blender/tests/$test.py"
   if ! "$py" "blender/tests/$test.py" "$zip" >"$log" 2>&1; then
     cat "$log" >&2

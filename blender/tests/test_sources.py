@@ -1,0 +1,109 @@
+"""The bake reads the armature's evaluated animation, wherever it comes from: the clip in
+an NLA strip (no active action) bakes as the same clip as the active action; a bone
+constraint's result is keyed (visual keying: with the constraint muted, the baked bone
+stands where the constraint put it); a parent object's motion moves the character.
+
+    python test_sources.py ZIP
+"""
+import math
+import os
+import sys
+
+import bpy
+
+sys.path.insert(0, os.path.dirname(__file__))
+import helpers  # noqa: E402
+
+FRAMES = 30
+helpers.fresh_blender(sys.argv[-1])
+scene = bpy.context.scene
+bpy.ops.import_scene.gltf(filepath=os.path.join(helpers.SHARED, "gltf", "Fox.glb"))
+fox = helpers.armature()
+run = bpy.data.actions["Run"]
+fox.tassel.rig_file = os.path.join(helpers.ROOT, "examples", "rigs", "fox.toml")
+bpy.context.view_layer.objects.active = fox
+tail = ["b_Tail02_013", "b_Tail03_014"]
+data = fox.animation_data
+for track in list(data.nla_tracks):
+    data.nla_tracks.remove(track)
+
+
+def bake_points(names):
+    assert bpy.ops.tassel.bake(frame_start=1, frame_end=FRAMES) == {"FINISHED"}
+    out = []
+    for f in range(1, FRAMES + 1):
+        scene.frame_set(f)
+        out.append(helpers.world_points(fox, names))
+    return out
+
+
+def gap(a, b, names):
+    return max((x[n][k] - y[n][k]).length for x, y in zip(a, b) for n in names for k in (0, 1))
+
+
+# 1. The active action, then the same clip from an NLA strip with no active action.
+data.action = run
+from_action = bake_points(tail)
+data.action = None
+track = data.nla_tracks.new()
+track.strips.new("Run", int(run.frame_range[0]), run)
+from_nla = bake_points(tail)
+d = gap(from_action, from_nla, tail)
+if d > 0.01:  # 1e-4 m in the fox's centimetre units
+    helpers.fail(f"the clip from an NLA strip bakes {d} units away from the same clip as the action")
+if data.action is None or data.action == run:
+    helpers.fail("the NLA bake did not assign a new action")
+print(f"OK the Run clip from an NLA strip bakes as from the action ({d:.1e} units)")
+data.nla_tracks.remove(track)
+
+# 2. A constraint: the hip's rotation limited; its keys hold the constrained pose.
+data.action = run
+hip = fox.pose.bones["b_Hip_01"]
+limit = hip.constraints.new("LIMIT_ROTATION")
+limit.use_limit_x = limit.use_limit_y = limit.use_limit_z = True
+limit.owner_space = "LOCAL"
+constrained = []
+for f in range(1, FRAMES + 1):
+    scene.frame_set(f)
+    constrained.append(fox.matrix_world @ hip.matrix)
+free_tail = []
+limit.mute = True
+for f in range(1, FRAMES + 1):
+    scene.frame_set(f)
+    free_tail.append((fox.matrix_world @ hip.matrix))
+limit.mute = False
+moved = max(max(abs(a[i][j] - b[i][j]) for i in range(3) for j in range(3)) for a, b in zip(constrained, free_tail))
+if moved < 1e-3:
+    helpers.fail("the constraint does not change the hip: the test would show nothing")
+bake_points(tail)
+limit.mute = True
+worst = 0.0
+for f, want in zip(range(1, FRAMES + 1), constrained):
+    scene.frame_set(f)
+    got = fox.matrix_world @ hip.matrix
+    worst = max(worst, max(abs(got[i][j] - want[i][j]) for i in range(4) for j in range(4)))
+if worst > 1e-3:
+    helpers.fail(f"the baked hip is {worst} from where the constraint put it")
+print(f"OK a Limit Rotation on the hip is keyed as it evaluated ({worst:.1e}; the constraint moves it {moved:.2f})")
+hip.constraints.remove(limit)
+
+# 3. A parent empty carrying the armature: its motion swings the tail.
+data.action = run
+still = bake_points(tail)
+carrier = bpy.data.objects.new("carrier", None)
+scene.collection.objects.link(carrier)
+fox.parent = carrier
+for f in range(1, FRAMES + 1):
+    carrier.location = (0.0, 40.0 * math.sin(2 * math.pi * f / 24), 0.0)
+    carrier.keyframe_insert("location", frame=f)
+data.action = run
+carried = bake_points(tail)
+# Compare in the carrier's frame: what is left is the tail's own lag.
+lag = 0.0
+for f, a, b in zip(range(1, FRAMES + 1), still, carried):
+    scene.frame_set(f)
+    shift = carrier.matrix_world.translation
+    lag = max(lag, max(((b[n][1] - shift) - a[n][1]).length for n in tail))
+if lag < 0.5:
+    helpers.fail(f"a parent's motion moves the tail only {lag} units off the carried clip")
+print(f"OK a parent object's motion swings the tail ({lag:.1f} units off the unswung bake)")
