@@ -7,10 +7,10 @@ export interface GLTFLike {
   parser: { associations: Map<unknown, { nodes?: number }> };
 }
 
-export type TasselMode = 'fixed' | 'spec' | 'three-vrm' | 'classic';
+export type TasselMode = 'fixed' | 'spec' | 'three-vrm' | 'classic' | 'kawaii';
 
 export interface TasselOptions {
-  /** fixed (default), spec, three-vrm or classic. */
+  /** fixed (default), spec, three-vrm, classic or kawaii. */
   mode?: TasselMode;
   /** Where the .wasm is (URL), its bytes, or a compiled module; default: beside index.js. */
   wasm?: string | URL | ArrayBuffer | Uint8Array | WebAssembly.Module;

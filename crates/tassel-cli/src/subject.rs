@@ -16,6 +16,8 @@ pub enum Mode {
     Classic,
     /// VRM springs as three-vrm 3.5.5 runs them in a web app.
     ThreeVrm,
+    /// Chains as KawaiiPhysics 1.21 steps them by default (fixed substepping).
+    Kawaii,
 }
 
 impl From<Mode> for SimMode {
@@ -25,6 +27,7 @@ impl From<Mode> for SimMode {
             Mode::Fixed => SimMode::Fixed,
             Mode::Classic => SimMode::Classic,
             Mode::ThreeVrm => SimMode::ThreeVrm,
+            Mode::Kawaii => SimMode::Kawaii,
         }
     }
 }

@@ -135,18 +135,20 @@ fn springs_from_json(
     Ok(info.map(|i| i.springs).unwrap_or_default())
 }
 
-/// `"fixed"`, `"spec"`, `"three-vrm"` or `"classic"` (as `tassel simulate --mode`).
+/// `"fixed"`, `"spec"`, `"three-vrm"`, `"classic"` or `"kawaii"` (as `tassel simulate
+/// --mode`).
 pub fn parse_mode(name: &str) -> Result<SimMode, String> {
     [
         SimMode::Fixed,
         SimMode::Spec,
         SimMode::ThreeVrm,
         SimMode::Classic,
+        SimMode::Kawaii,
     ]
     .into_iter()
     .find(|m| m.name() == name)
     .ok_or_else(|| {
-        format!("mode '{name}' is not one of fixed, spec, three-vrm, classic (as tassel simulate --mode)")
+        format!("mode '{name}' is not one of fixed, spec, three-vrm, classic, kawaii (as tassel simulate --mode)")
     })
 }
 

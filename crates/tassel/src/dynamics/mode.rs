@@ -22,24 +22,29 @@ pub enum SimMode {
     /// VRM springs as three-vrm 3.5.5 runs them in a web app ([`VrmMode::ThreeVrm`]): what
     /// web viewers show; rig chains keep the mode the rig file gives them.
     ThreeVrm,
+    /// Chains as KawaiiPhysics 1.21 steps them by default (its fixed substepping:
+    /// [`TimeMode::Kawaii`]), VRM springs by the specification: for a user moving from
+    /// KawaiiPhysics 1.21.
+    Kawaii,
 }
 
 impl SimMode {
-    /// `spec`, `fixed`, `classic` or `three-vrm`.
+    /// `spec`, `fixed`, `classic`, `three-vrm` or `kawaii`.
     pub fn name(self) -> &'static str {
         match self {
             SimMode::Spec => "spec",
             SimMode::Fixed => "fixed",
             SimMode::Classic => "classic",
             SimMode::ThreeVrm => "three-vrm",
+            SimMode::Kawaii => "kawaii",
         }
     }
 
     /// Settles the mode for a rig (and a model with or without VRM springs) and sets the
     /// rig's chains to it. Without a requested mode: `fixed` for a model with VRM springs,
     /// else the first chain's own mode (the rig file's choice; `fixed` unless it says
-    /// `classic`). `spec` without VRM springs is an error; `fixed` or
-    /// `classic` asked for explicitly set every chain's mode.
+    /// `classic` or `kawaii`). `spec` without VRM springs is an error; `fixed`, `classic`
+    /// or `kawaii` asked for explicitly set every chain's mode.
     pub fn apply(
         requested: Option<SimMode>,
         rig: &mut RigSettings,
@@ -50,6 +55,7 @@ impl SimMode {
             None if has_vrm => SimMode::Fixed,
             None => match rig.chains.first().map(|c| c.mode) {
                 Some(TimeMode::Classic) => SimMode::Classic,
+                Some(TimeMode::Kawaii) => SimMode::Kawaii,
                 _ => SimMode::Fixed,
             },
         };
@@ -59,20 +65,22 @@ impl SimMode {
                 mode.name()
             )));
         }
-        if requested.is_some() && matches!(mode, SimMode::Fixed | SimMode::Classic) {
+        if requested.is_some() {
+            let chains = match mode {
+                SimMode::Classic => Some(TimeMode::Classic),
+                SimMode::Fixed => Some(TimeMode::Fixed),
+                SimMode::Kawaii => Some(TimeMode::Kawaii),
+                SimMode::Spec | SimMode::ThreeVrm => None,
+            };
             for c in &mut rig.chains {
-                c.mode = if mode == SimMode::Classic {
-                    TimeMode::Classic
-                } else {
-                    TimeMode::Fixed
-                };
+                c.mode = chains.unwrap_or(c.mode);
             }
         }
         let options = rig.vrm.apply(VrmOptions {
             mode: match mode {
                 SimMode::Fixed => VrmMode::Fixed,
                 SimMode::ThreeVrm => VrmMode::ThreeVrm,
-                SimMode::Spec | SimMode::Classic => VrmMode::Spec,
+                SimMode::Spec | SimMode::Classic | SimMode::Kawaii => VrmMode::Spec,
             },
             ..VrmOptions::default()
         });

@@ -41,6 +41,7 @@ impl CompiledChain {
         s.simulation_space != super::SimulationSpace::Component
             || s.skel_comp_move_scale != glam::Vec3::ONE
             || s.wind.direction_noise_angle > 0.0
+            || s.mode == super::TimeMode::Kawaii
     }
 }
 

@@ -631,7 +631,7 @@ fn reset_chain(
             wind_cs: wind_cs(s, component),
             dt: h,
             dt_old: h,
-            fixed: s.mode == TimeMode::Fixed,
+            fixed: accelerates(s),
             world: None,
             push: &[],
             accel: &[],
@@ -864,6 +864,13 @@ fn run_chain(
                 }
             }
             TimeMode::Fixed => run_fixed(rig, ci, state, dt, level),
+            TimeMode::Kawaii => {
+                let alone = ChainGroup {
+                    chains: vec![ci],
+                    constraints: 0..0,
+                };
+                run_kawaii(rig, &alone, state, component, dt, level);
+            }
         }
     }
     // Guard: never let a non-finite value out; start again from the pose instead.
@@ -985,6 +992,149 @@ fn place_step(rig: &ChainRig, ci: usize, state: &mut ChainState, w: f32) {
             state.step_colliders[c] = state.prev_colliders[c].lerp(&state.colliders[c], w);
             state.step_bounds[c] = state.step_colliders[c].bound_sphere();
             state.step_placed_at[c] = w;
+        }
+    }
+}
+
+/// Whether a step adds gravity as an acceleration (`g·dt²`): `fixed` mode always;
+/// `kawaii` mode unless the rig asks for KawaiiPhysics' legacy `½·g·dt²`
+/// (`classic_gravity = "half_dt_squared"`; 1.21's default is the acceleration);
+/// `classic` mode by `classic_gravity`.
+fn accelerates(s: &super::ChainSettings) -> bool {
+    match s.mode {
+        TimeMode::Fixed => true,
+        TimeMode::Kawaii => s.classic_gravity != super::ClassicGravity::HalfDtSquared,
+        TimeMode::Classic => false,
+    }
+}
+
+/// A `kawaii`-mode frame of a group of chains (or of one chain alone): KawaiiPhysics
+/// 1.21's `SimulateModifyBones` with fixed substepping, as its code runs (f32):
+///
+/// - the step is `1 / target_framerate`; the time to step is the accumulator plus the
+///   frame (at least 1e-4 s: `KINDA_SMALL_NUMBER`), capped at `max_substeps` steps, the
+///   excess dropped; the whole steps in it run, the rest carries to the next frame;
+/// - substep `k` of `n` steps toward the pose at `k / n` of the way from last frame's to
+///   this frame's (positions lerped, planar normals nlerped), with this frame's colliders;
+/// - each substep takes `step / time to step` of the character's motion since the
+///   place the chain last consumed (`last_step_component`), which then advances by the
+///   share of that time consumed or dropped (lerp, slerp): motion not yet stepped
+///   reaches the next frame that steps;
+/// - the steps run 1.20/1.21's phase order ([`step_group`]): every point integrated
+///   (velocity over the last step, damping, gravity `g·dt²`, the share of motion, the
+///   pull with the exponent `target_framerate · step`), constraints (compliance over
+///   the step²), collisions, constraints, limits and bone lengths;
+/// - no output interpolation: the points are where the last substep left them.
+fn run_kawaii(
+    rig: &ChainRig,
+    group: &ChainGroup,
+    state: &mut ChainState,
+    component: &Transform,
+    dt: f32,
+    level: Option<&Level>,
+) {
+    let lead = group.chains[0];
+    let s = &rig.chains[lead].settings;
+    let h = 1.0 / s.target_framerate;
+    let raw = (state.accumulator[lead] + dt).max(1e-4);
+    let mut accumulated = raw.min(s.max_substeps as f32 * h);
+    let dropped = raw - accumulated;
+    let steps = (accumulated / h).floor() as u32;
+    accumulated -= steps as f32 * h;
+    let share = h / raw;
+    let consumed = ((steps as f32 * h + dropped) / raw).clamp(0.0, 1.0);
+    let from = state.last_step_component[lead];
+    for &ci in &group.chains {
+        state.accumulator[ci] = accumulated;
+        // The whole frame's motion (carried into this frame's simulation space), shared
+        // out below.
+        state.space_in[ci] = space_step(rig, ci, state, from, *component, state.base_now[ci]);
+    }
+    for k in 1..=steps {
+        let alpha = k as f32 / steps as f32;
+        for &ci in &group.chains {
+            for p in rig.chains[ci].points.clone() {
+                state.step_targets[p] = state.prev_targets[p].lerp(state.targets[p], alpha);
+                state.step_normals[p] = normalize_or(
+                    state.prev_normals[p].lerp(state.normals[p], alpha),
+                    state.normals[p],
+                );
+            }
+            state.world_near[ci] = world_for(
+                rig,
+                ci,
+                level,
+                &state.pos,
+                &state.step_targets,
+                &from,
+                component,
+            )
+            .is_some();
+            state
+                .forces
+                .prepare(rig, ci, h, alpha, component, &state.pos, &state.step_targets);
+        }
+        let ChainState {
+            pos,
+            prev,
+            rng,
+            lambda,
+            step_targets,
+            step_normals,
+            colliders,
+            bounds,
+            world_near,
+            forces,
+            space_in,
+            ..
+        } = &mut *state;
+        let forces = &*forces;
+        let input_of = |ci: usize| {
+            let s = &rig.chains[ci].settings;
+            let (move_cs, rotate_cs, base) = space_in[ci];
+            StepInput {
+                targets: step_targets,
+                normals: step_normals,
+                colliders,
+                bounds,
+                move_cs: move_cs * share,
+                rotate_cs: Quat::IDENTITY.slerp(rotate_cs, share).normalize(),
+                gravity_cs: gravity_cs(s, component),
+                wind_cs: wind_cs(s, component),
+                dt: h,
+                dt_old: h,
+                fixed: accelerates(s),
+                world: level.filter(|_| world_near[ci]).map(|level| WorldContact {
+                    level,
+                    from,
+                    to: *component,
+                }),
+                push: if forces.reaches(ci) {
+                    &forces.push
+                } else {
+                    &[]
+                },
+                accel: &forces.accel,
+                base,
+            }
+        };
+        step_group(rig, group, &input_of, pos, prev, rng, lambda);
+    }
+    let advanced = if consumed >= 1.0 - 1e-4 {
+        *component
+    } else {
+        Transform::new(
+            from.translation.lerp(component.translation, consumed),
+            from.rotation.slerp(component.rotation, consumed).normalize(),
+            from.scale.lerp(component.scale, consumed),
+        )
+    };
+    for &ci in &group.chains {
+        state.dt_old[ci] = h;
+        state.last_step_component[ci] = advanced;
+        for p in rig.chains[ci].points.clone() {
+            state.dev[p] = state.pos[p] - state.targets[p];
+            state.dev_before[p] = state.dev[p];
         }
     }
 }
@@ -1192,6 +1342,7 @@ fn run_group(
                 }
             }
             TimeMode::Fixed => run_fixed_group(rig, group, state, dt, level),
+            TimeMode::Kawaii => run_kawaii(rig, group, state, component, dt, level),
         }
     }
     // Guard: never let a non-finite value out; start again from the pose instead.
@@ -1217,7 +1368,7 @@ fn reset_group(rig: &ChainRig, group: &ChainGroup, state: &mut ChainState, compo
     }
     let s = &rig.chains[group.chains[0]].settings;
     let h = 1.0 / s.target_framerate;
-    let fixed = s.mode == TimeMode::Fixed;
+    let fixed = accelerates(s);
     {
         let ChainState {
             pos,

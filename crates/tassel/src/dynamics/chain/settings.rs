@@ -17,6 +17,12 @@ pub enum TimeMode {
     /// longer depends on the frame rate.
     #[default]
     Fixed,
+    /// KawaiiPhysics 1.21's fixed substepping (its default, `bUseFixedSubstepping`), as
+    /// its code runs: steps of `1 / target_framerate` (f32), an accumulator capped at
+    /// `max_substeps` steps (the excess dropped), pose targets interpolated across the
+    /// substeps, the character's motion shared out by step and carried over by the part
+    /// of the frame consumed, 1.20's phase order, no output interpolation.
+    Kawaii,
 }
 
 /// How `classic` mode applies gravity each frame (KawaiiPhysics changed it twice).
@@ -103,6 +109,10 @@ pub struct Wind {
 
 fn is_zero(v: &f32) -> bool {
     *v == 0.0
+}
+
+fn is_four(n: &u32) -> bool {
+    *n == 4
 }
 
 fn is_one(v: &Vec3) -> bool {
@@ -204,6 +214,10 @@ pub struct ChainSettings {
     pub max_steps_per_frame: u32,
     /// `classic` mode: a longer frame is clamped to this, seconds.
     pub max_delta_time: f32,
+    /// `kawaii` mode: at most this many substeps per frame (KawaiiPhysics' `MaxSubsteps`,
+    /// 1..=16, default 4); the time beyond is dropped.
+    #[serde(skip_serializing_if = "is_four")]
+    pub max_substeps: u32,
     /// The space the chain simulates in.
     #[serde(skip_serializing_if = "is_component")]
     pub simulation_space: SimulationSpace,
@@ -246,6 +260,7 @@ impl Default for ChainSettings {
             world_collision: false,
             max_steps_per_frame: 10,
             max_delta_time: 0.1,
+            max_substeps: 4,
             simulation_space: SimulationSpace::Component,
             simulation_base_bone: String::new(),
             skel_comp_move_scale: Vec3::ONE,
@@ -307,6 +322,12 @@ impl ChainSettings {
             return bad(format!(
                 "max_steps_per_frame is {}; it must be 1..={max_steps}",
                 self.max_steps_per_frame
+            ));
+        }
+        if !(1..=16).contains(&self.max_substeps) {
+            return bad(format!(
+                "max_substeps is {}; it must be 1..=16",
+                self.max_substeps
             ));
         }
         let max_warmup = crate::limits::MAX_WARMUP_STEPS;

@@ -715,6 +715,12 @@ impl Ctx<'_> {
             match set.mode {
                 TimeMode::Classic => self.run_classic::<T>(ci, pack, s, run, ahead),
                 TimeMode::Fixed => self.run_fixed::<T>(ci, pack, s, run, ahead),
+                // `kawaii` chains step per character (`CompiledChain::scalar_only`): the
+                // lanes never hold one.
+                TimeMode::Kawaii => {
+                    debug_assert!(false, "a kawaii chain in lanes");
+                    self.run_classic::<T>(ci, pack, s, run, ahead)
+                }
             }
         }
         // Guard: never let a non-finite value out; start again from the pose instead.
@@ -735,7 +741,7 @@ impl Ctx<'_> {
             TimeMode::Fixed => {
                 (pack.accumulator[ci] / F::splat(1.0 / set.target_framerate)).clamp01()
             }
-            TimeMode::Classic => F::splat(1.0),
+            TimeMode::Classic | TimeMode::Kawaii => F::splat(1.0),
         };
         output_lanes::<T>(
             rig,
