@@ -28,15 +28,7 @@ class TasselSettings(bpy.types.PropertyGroup):
         name="VRM Spring Bones", default=True, update=_changed,
         description="Also run the spring bones the VRM Add-on for Blender holds (VRM 1.0 and 0.x)",
     )
-    mode: bpy.props.EnumProperty(
-        name="Mode", default="FIXED", update=_changed,
-        items=[(k, label, desc) for k, label, desc in (
-            ("FIXED", "Fixed", "Fixed internal steps: the look does not depend on the frame rate"),
-            ("SPEC", "Spec", "VRM springs as the VRM specification steps them, once a frame"),
-            ("THREE_VRM", "three-vrm", "VRM springs as three-vrm 3.5.5 runs them"),
-            ("CLASSIC", "Classic", "Chains frame by frame, as KawaiiPhysics"),
-        )],
-    )
+    mode: bpy.props.EnumProperty(name="Mode", default="FIXED", update=_changed, items=character.MODE_ITEMS)
     step_rate: bpy.props.FloatProperty(
         name="Step Rate", default=60.0, min=10.0, max=1000.0, update=_changed,
         description="Fixed mode: VRM spring steps per second (chains step at their rig's target_framerate)",

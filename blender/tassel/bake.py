@@ -200,16 +200,7 @@ class TASSEL_OT_bake(bpy.types.Operator):
     bl_label = "Bake Secondary Motion"
     bl_options = {"REGISTER", "UNDO"}
 
-    mode: bpy.props.EnumProperty(
-        name="Mode",
-        items=[
-            ("FIXED", "Fixed", "Fixed internal steps: the look does not depend on the frame rate"),
-            ("SPEC", "Spec", "VRM springs as the VRM specification steps them, once a frame"),
-            ("THREE_VRM", "three-vrm", "VRM springs as three-vrm 3.5.5 runs them"),
-            ("CLASSIC", "Classic", "Chains frame by frame, as KawaiiPhysics"),
-        ],
-        default="FIXED",
-    )
+    mode: bpy.props.EnumProperty(name="Mode", items=character.MODE_ITEMS, default="FIXED")
     frame_start: bpy.props.IntProperty(name="Start", description="First frame (places the solvers)")
     frame_end: bpy.props.IntProperty(name="End", description="Last frame")
     step_rate: bpy.props.FloatProperty(

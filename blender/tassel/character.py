@@ -7,7 +7,17 @@ import numpy as np
 
 from . import native, pose, springs
 
-MODES = {"FIXED": "fixed", "SPEC": "spec", "THREE_VRM": "three-vrm", "CLASSIC": "classic"}
+MODES = {"FIXED": "fixed", "SPEC": "spec", "THREE_VRM": "three-vrm", "CLASSIC": "classic", "KAWAII": "kawaii"}
+
+# The modes as Blender's enum items (identifier, name, description), shared by the panel's
+# setting and the operator.
+MODE_ITEMS = [
+    ("FIXED", "Fixed", "Fixed internal steps: the look does not depend on the frame rate"),
+    ("SPEC", "Spec", "VRM springs as the VRM specification steps them, once a frame"),
+    ("THREE_VRM", "three-vrm", "VRM springs as three-vrm 3.5.5 runs them"),
+    ("CLASSIC", "Classic", "Chains frame by frame, as KawaiiPhysics 1.10"),
+    ("KAWAII", "KawaiiPhysics 1.21", "Chains as KawaiiPhysics 1.21's fixed substepping runs them"),
+]
 DEFAULT_STEP_RATE = 60.0
 
 

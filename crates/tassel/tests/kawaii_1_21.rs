@@ -186,7 +186,12 @@ fn kawaii_matches_kawaiiphysics_1_21_fixed_substepping() {
     let rig = kawaii_rig();
     let mut worst_all = 0.0f64;
     for motion in ["still", "sway", "step", "turn", "nod"] {
-        for (label, hz) in [("30", 30.0f64), ("60", 60.0), ("144", 144.0), ("hitch", 60.0)] {
+        for (label, hz) in [
+            ("30", 30.0f64),
+            ("60", 60.0),
+            ("144", 144.0),
+            ("hitch", 60.0),
+        ] {
             let mut sim = CharacterSim::new(sk.clone(), &rig).unwrap();
             let mut kp = Kawaii121::new();
             let mut kp32 = Kawaii121f32::new();
@@ -197,7 +202,11 @@ fn kawaii_matches_kawaiiphysics_1_21_fixed_substepping() {
             let mut t = 0.0f64;
             for f in 1..=120 {
                 // The hitch: a 0.25 s frame (more than 4 substeps: time is dropped).
-                let dt = if label == "hitch" && f == 50 { 0.25 } else { 1.0 / hz };
+                let dt = if label == "hitch" && f == 50 {
+                    0.25
+                } else {
+                    1.0 / hz
+                };
                 t += dt;
                 let (pos, rot) = component(if motion == "nod" { "still" } else { motion }, t);
                 let angle = nod(motion, t);
@@ -234,7 +243,8 @@ fn kawaii_matches_kawaiiphysics_1_21_fixed_substepping() {
 /// every chain; such chains step per character (not in crowd lanes).
 #[test]
 fn kawaii_keys_are_read_and_checked() {
-    let ok = "[[chain]]\nname = \"hair\"\nroot = \"hair_0\"\nmode = \"kawaii\"\nmax_substeps = 16\n";
+    let ok =
+        "[[chain]]\nname = \"hair\"\nroot = \"hair_0\"\nmode = \"kawaii\"\nmax_substeps = 16\n";
     let rig = RigSettings::from_toml_str(ok).unwrap();
     assert_eq!(rig.chains[0].mode, TimeMode::Kawaii);
     assert_eq!(rig.chains[0].max_substeps, 16);
@@ -248,9 +258,12 @@ fn kawaii_keys_are_read_and_checked() {
     assert_eq!(plain.chains[0].max_substeps, 4);
     assert!(!plain.to_toml_string().unwrap().contains("max_substeps"));
     let mut asked = plain.clone();
-    let (mode, _) =
-        tassel::dynamics::SimMode::apply(Some(tassel::dynamics::SimMode::Kawaii), &mut asked, false)
-            .unwrap();
+    let (mode, _) = tassel::dynamics::SimMode::apply(
+        Some(tassel::dynamics::SimMode::Kawaii),
+        &mut asked,
+        false,
+    )
+    .unwrap();
     assert_eq!(mode.name(), "kawaii");
     assert_eq!(asked.chains[0].mode, TimeMode::Kawaii);
     let sim = CharacterSim::new(skeleton(), &rig).unwrap();

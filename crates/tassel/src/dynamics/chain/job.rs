@@ -1070,9 +1070,15 @@ fn run_kawaii(
                 component,
             )
             .is_some();
-            state
-                .forces
-                .prepare(rig, ci, h, alpha, component, &state.pos, &state.step_targets);
+            state.forces.prepare(
+                rig,
+                ci,
+                h,
+                alpha,
+                component,
+                &state.pos,
+                &state.step_targets,
+            );
         }
         let ChainState {
             pos,
@@ -1125,7 +1131,9 @@ fn run_kawaii(
     } else {
         Transform::new(
             from.translation.lerp(component.translation, consumed),
-            from.rotation.slerp(component.rotation, consumed).normalize(),
+            from.rotation
+                .slerp(component.rotation, consumed)
+                .normalize(),
             from.scale.lerp(component.scale, consumed),
         )
     };
