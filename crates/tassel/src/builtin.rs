@@ -127,6 +127,8 @@ fn skeleton() -> Skeleton {
 
 fn rig() -> RigSettings {
     let col = |name: &str, bone: &str, offset: Vec3, shape: Shape| ColliderSettings {
+        mirror: None,
+        mirror_bone: String::new(),
         name: name.into(),
         bone: bone.into(),
         offset,
@@ -490,6 +492,8 @@ pub fn bench_character(chains: usize, joints: usize, colliders: usize) -> (Skele
             }
         };
         rig.colliders.push(ColliderSettings {
+            mirror: None,
+            mirror_bone: String::new(),
             name: format!("k{k}"),
             bone: "root".into(),
             offset,

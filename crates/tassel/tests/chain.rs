@@ -189,6 +189,8 @@ fn stiffness_one_gives_the_animated_pose() {
 
 fn collider(name: &str, offset: Vec3, shape: Shape) -> ColliderSettings {
     ColliderSettings {
+        mirror: None,
+        mirror_bone: String::new(),
         name: name.into(),
         bone: "anchor".into(),
         offset,

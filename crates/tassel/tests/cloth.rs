@@ -292,6 +292,8 @@ fn sphere_through_sheet(mode: SurfaceCollision) -> f32 {
             ..Default::default()
         }],
         colliders: vec![ColliderSettings {
+            mirror: None,
+            mirror_bone: String::new(),
             name: "ball".into(),
             bone: "mover".into(),
             offset: Vec3::ZERO,

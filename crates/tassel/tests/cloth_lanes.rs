@@ -152,6 +152,8 @@ fn sheet() -> (Skeleton, Vec<[String; 2]>) {
 
 fn collider(name: &str, offset: Vec3, rotation: Quat, shape: Shape) -> ColliderSettings {
     ColliderSettings {
+        mirror: None,
+        mirror_bone: String::new(),
         name: name.into(),
         bone: if name == "floor" || name == "limit" {
             "root"

@@ -453,6 +453,8 @@ fn rig(gravity: ClassicGravity, limit: bool) -> RigSettings {
         }],
         colliders: vec![
             ColliderSettings {
+                mirror: None,
+                mirror_bone: String::new(),
                 name: "head".into(),
                 bone: "hair_0".into(),
                 offset: offset(SPHERE_CENTER),
@@ -463,6 +465,8 @@ fn rig(gravity: ClassicGravity, limit: bool) -> RigSettings {
                 },
             },
             ColliderSettings {
+                mirror: None,
+                mirror_bone: String::new(),
                 name: "shoulders".into(),
                 bone: "hair_0".into(),
                 offset: offset(CAPSULE_CENTER),

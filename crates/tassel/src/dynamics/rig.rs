@@ -33,6 +33,84 @@ pub struct ColliderSettings {
     /// The shape.
     #[serde(flatten)]
     pub shape: Shape,
+    /// Also make this collider's twin on the other side of the character, mirrored across
+    /// the plane normal to this axis of the character (`"x"`: left ↔ right for a glTF
+    /// character; KawaiiPhysics 1.21's mirrored limits): named `<name>_mirror`, on the
+    /// bone `mirror_bone` names, or else the bone whose name swaps a side marker
+    /// (`_L`/`_R`, `.L`/`.R`, `L_`/`R_`, `Left`/`Right`, in either case).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mirror: Option<MirrorAxis>,
+    /// The twin's bone, when the side markers do not find it.
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub mirror_bone: String,
+}
+
+/// The axis a mirrored collider is reflected along (the plane of symmetry is normal to it).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MirrorAxis {
+    /// The character's X axis (left and right of a glTF character facing +Z).
+    X,
+    /// Its Y axis.
+    Y,
+    /// Its Z axis.
+    Z,
+}
+
+impl MirrorAxis {
+    /// `v` reflected across the plane normal to this axis (`FAnimationRuntime::MirrorVector`).
+    pub fn vector(self, v: Vec3) -> Vec3 {
+        match self {
+            MirrorAxis::X => Vec3::new(-v.x, v.y, v.z),
+            MirrorAxis::Y => Vec3::new(v.x, -v.y, v.z),
+            MirrorAxis::Z => Vec3::new(v.x, v.y, -v.z),
+        }
+    }
+
+    /// The rotation `q` seen in the mirror (`M·R·M`: `FAnimationRuntime::MirrorQuat`).
+    pub fn rotation(self, q: Quat) -> Quat {
+        match self {
+            MirrorAxis::X => Quat::from_xyzw(q.x, -q.y, -q.z, q.w),
+            MirrorAxis::Y => Quat::from_xyzw(-q.x, q.y, -q.z, q.w),
+            MirrorAxis::Z => Quat::from_xyzw(-q.x, -q.y, q.z, q.w),
+        }
+    }
+}
+
+/// Side markers a mirrored collider's bone name may carry, swapped to find its twin:
+/// suffixes, prefixes, then anywhere in the name.
+const SIDE_SUFFIXES: [(&str, &str); 4] = [("_L", "_R"), ("_l", "_r"), (".L", ".R"), (".l", ".r")];
+const SIDE_PREFIXES: [(&str, &str); 2] = [("L_", "R_"), ("l_", "r_")];
+const SIDE_WORDS: [(&str, &str); 3] = [("Left", "Right"), ("left", "right"), ("LEFT", "RIGHT")];
+
+/// The bone on the other side of `name`, by its side marker, if the skeleton has it.
+fn mirror_bone_of(skeleton: &Skeleton, name: &str) -> Option<usize> {
+    let swaps = |a: &str, b: &str| {
+        [
+            (a.to_string(), b.to_string()),
+            (b.to_string(), a.to_string()),
+        ]
+    };
+    let mut candidates = Vec::new();
+    for (a, b) in SIDE_SUFFIXES.iter().flat_map(|(a, b)| swaps(a, b)) {
+        if let Some(stem) = name.strip_suffix(a.as_str()) {
+            candidates.push(format!("{stem}{b}"));
+        }
+    }
+    for (a, b) in SIDE_PREFIXES.iter().flat_map(|(a, b)| swaps(a, b)) {
+        if let Some(rest) = name.strip_prefix(a.as_str()) {
+            candidates.push(format!("{b}{rest}"));
+        }
+    }
+    for (a, b) in SIDE_WORDS.iter().flat_map(|(a, b)| swaps(a, b)) {
+        if name.contains(a.as_str()) {
+            candidates.push(name.replacen(a.as_str(), &b, 1));
+        }
+    }
+    candidates
+        .iter()
+        .filter(|c| c.as_str() != name)
+        .find_map(|c| skeleton.find(c))
 }
 
 fn identity() -> Quat {
@@ -177,6 +255,101 @@ impl RigSettings {
     /// The rig as TOML text.
     pub fn to_toml_string(&self) -> Result<String> {
         toml::to_string(self).map_err(|e| Error::RigParse(e.to_string()))
+    }
+
+    /// The rig with the twin of each collider that asks for one (`mirror`): KawaiiPhysics
+    /// 1.21's mirrored limits (`KawaiiPhysicsMirror::AppendMirroredLimits`). The twin
+    /// rides the mirror bone with the offset and rotation KawaiiPhysics gives it, from the
+    /// two bones' rest rotations in the character's space (`Rs`, `Rt`) and the mirror `M`:
+    /// `offset = Rt⁻¹ · M(Rs · offset)`, `rotation = Rt⁻¹ · M(Rs · rotation) · M(Rs)⁻¹ ·
+    /// Rt`. So on a symmetric rest pose the twin's centre is the source's mirrored. Every
+    /// chain, cloth and rope that names the source also collides with the twin. Borrowed
+    /// when no collider mirrors. An error names a collider whose twin bone cannot be
+    /// found, is its own bone, or whose twin's name is taken.
+    pub fn mirrored(&self, skeleton: &Skeleton) -> Result<std::borrow::Cow<'_, RigSettings>> {
+        use std::borrow::Cow;
+        if self.colliders.iter().all(|c| c.mirror.is_none()) {
+            return Ok(Cow::Borrowed(self));
+        }
+        // Rest rotations in the character's space (parents come before children).
+        let mut rest_cs: Vec<Quat> = Vec::with_capacity(skeleton.len());
+        for j in 0..skeleton.len() {
+            let local = skeleton.rest()[j].rotation;
+            let q = match skeleton.parent(j) {
+                Some(p) => rest_cs[p] * local,
+                None => local,
+            };
+            rest_cs.push(q.normalize());
+        }
+        let mut out = self.clone();
+        let mut twins: Vec<(String, String)> = Vec::new();
+        for c in &self.colliders {
+            let Some(axis) = c.mirror else { continue };
+            let what = format!("collider '{}' mirror", c.name);
+            let source = skeleton.find(&c.bone).ok_or_else(|| Error::MissingBone {
+                context: format!("collider '{}' bone", c.name),
+                name: c.bone.clone(),
+            })?;
+            let target = if c.mirror_bone.is_empty() {
+                mirror_bone_of(skeleton, &c.bone).ok_or_else(|| {
+                    Error::InvalidParameter(format!(
+                        "{what}: no bone mirrors '{}' (no _L/_R, .L/.R, L_/R_ or Left/Right \
+                         twin in the skeleton); name it with mirror_bone",
+                        c.bone
+                    ))
+                })?
+            } else {
+                skeleton
+                    .find(&c.mirror_bone)
+                    .ok_or_else(|| Error::MissingBone {
+                        context: format!("collider '{}' mirror_bone", c.name),
+                        name: c.mirror_bone.clone(),
+                    })?
+            };
+            if target == source {
+                return Err(Error::InvalidParameter(format!(
+                    "{what}: bone '{}' is its own mirror",
+                    c.bone
+                )));
+            }
+            let (rs, rt) = (rest_cs[source], rest_cs[target]);
+            let offset = rt.inverse() * axis.vector(rs * c.offset);
+            let rotation = (rt.inverse()
+                * axis.rotation(rs * c.rotation.normalize())
+                * axis.rotation(rs).inverse()
+                * rt)
+                .normalize();
+            let name = format!("{}_mirror", c.name);
+            twins.push((c.name.clone(), name.clone()));
+            out.colliders.push(ColliderSettings {
+                name,
+                bone: skeleton.name(target).to_string(),
+                offset,
+                rotation,
+                shape: c.shape,
+                mirror: None,
+                mirror_bone: String::new(),
+            });
+        }
+        let add_twins = |names: &mut Vec<String>| {
+            for (source, twin) in &twins {
+                if names.contains(source) && !names.contains(twin) {
+                    names.push(twin.clone());
+                }
+            }
+        };
+        for c in &mut out.chains {
+            add_twins(&mut c.colliders);
+        }
+        for c in &mut out.cloths {
+            add_twins(&mut c.colliders);
+        }
+        for r in &mut out.ropes {
+            add_twins(&mut r.colliders);
+        }
+        // The twins' names must be free (checked with everything else).
+        out.validate()?;
+        Ok(Cow::Owned(out))
     }
 
     /// Checks parameter ranges and internal references (not bone names: see

@@ -149,6 +149,7 @@ impl Ropes {
             return Ok(out);
         }
         rig.validate_for(skeleton)?;
+        let rig = &*rig.mirrored(skeleton)?;
         let all = CompiledCollider::compile_all(skeleton, rig);
         for s in &rig.ropes {
             let missing = |n: &str| Error::MissingBone {

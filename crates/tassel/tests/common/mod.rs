@@ -219,6 +219,8 @@ pub fn every_collider_shape(rig: &mut tassel::dynamics::RigSettings) {
     };
     rig.colliders[3].rotation = Quat::from_rotation_z(0.6);
     rig.colliders.push(ColliderSettings {
+        mirror: None,
+        mirror_bone: String::new(),
         name: "floor".into(),
         bone: "root".into(),
         offset: Vec3::new(0.0, -0.32, 0.0),
@@ -226,6 +228,8 @@ pub fn every_collider_shape(rig: &mut tassel::dynamics::RigSettings) {
         shape: Shape::Plane,
     });
     rig.colliders.push(ColliderSettings {
+        mirror: None,
+        mirror_bone: String::new(),
         name: "limit".into(),
         bone: "root".into(),
         offset: Vec3::ZERO,

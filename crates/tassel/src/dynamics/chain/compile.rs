@@ -111,6 +111,7 @@ impl ChainRig {
     /// depth-first, evaluates the parameter curves. Errors name the chain or collider.
     pub fn new(skeleton: &Skeleton, rig: &RigSettings) -> Result<Self> {
         rig.validate_for(skeleton)?;
+        let rig = &*rig.mirrored(skeleton)?;
         let rest = Pose::rest(skeleton);
         let mut pairs = 0usize;
         let mut out = ChainRig {

@@ -151,6 +151,7 @@ impl ClothRig {
     /// Compiles every cloth of `rig` for `skeleton`. Errors name the cloth and the bone.
     pub fn new(skeleton: &Skeleton, rig: &RigSettings) -> Result<Self> {
         rig.validate_for(skeleton)?;
+        let rig = &*rig.mirrored(skeleton)?;
         let mut out = ClothRig::default();
         if rig.cloths.is_empty() {
             return Ok(out);
