@@ -107,3 +107,39 @@ for f, a, b in zip(range(1, FRAMES + 1), still, carried):
 if lag < 0.5:
     helpers.fail(f"a parent's motion moves the tail only {lag} units off the carried clip")
 print(f"OK a parent object's motion swings the tail ({lag:.1f} units off the unswung bake)")
+
+# 4. Bones in Euler and axis-angle rotation modes are keyed in their own channels, and the
+#    baked motion is the same as in quaternion mode. (The clip keys the tail in
+#    quaternions, which a bone in another mode ignores: the tail's channels are left out
+#    of the clip for both bakes, so both read the same animation.)
+fox.parent = None
+untailed = run.copy()
+for bag in untailed.layers[0].strips[0].channelbags:
+    for fc in [fc for fc in bag.fcurves if any(b in fc.data_path for b in tail)]:
+        bag.fcurves.remove(fc)
+
+
+
+def unkeyed_tail_at_rest():
+    # What a bake left on the unkeyed bones stays on them: put them back at rest.
+    for name in tail:
+        fox.pose.bones[name].matrix_basis.identity()
+
+
+data.action = untailed
+unkeyed_tail_at_rest()
+quaternion_mode = bake_points(tail)
+for name, mode in (("b_Tail02_013", "XYZ"), ("b_Tail03_014", "AXIS_ANGLE")):
+    fox.pose.bones[name].rotation_mode = mode
+data.action = untailed
+unkeyed_tail_at_rest()
+other_modes = bake_points(tail)
+baked = data.action
+paths = {fc.data_path for bag in baked.layers[0].strips[0].channelbags for fc in bag.fcurves}
+for name, channel in (("b_Tail02_013", "rotation_euler"), ("b_Tail03_014", "rotation_axis_angle")):
+    if f'pose.bones["{name}"].{channel}' not in paths:
+        helpers.fail(f"{name} is not keyed in {channel}")
+d = gap(quaternion_mode, other_modes, tail)
+if d > 0.01:
+    helpers.fail(f"Euler / axis-angle keys move the tail {d} units from the quaternion keys")
+print(f"OK Euler and axis-angle bones keyed in their own channels, the tail as in quaternion mode ({d:.1e} units)")
