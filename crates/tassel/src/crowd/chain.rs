@@ -76,8 +76,8 @@ impl ChainCrowd {
         if rig.needs_per_character() {
             return Err(Error::InvalidParameter(
                 "a chain crowd cannot step bone constraints, sync bones, external forces, \
-                 a simulation space other than the character's, a move scale or a noisy \
-                 wind: run such characters through CharacterSim"
+                 a simulation space other than the character's, a move scale, a noisy \
+                 wind or kawaii mode: run such characters through CharacterSim"
                     .into(),
             ));
         }

@@ -35,7 +35,7 @@ pub(crate) struct CompiledChain {
 
 impl CompiledChain {
     /// Whether the chain's settings ask for what only the scalar step does: a simulation
-    /// space other than the character's, a move scale, a noisy wind.
+    /// space other than the character's, a move scale, a noisy wind, `kawaii` mode.
     pub(crate) fn scalar_only(&self) -> bool {
         let s = &self.settings;
         s.simulation_space != super::SimulationSpace::Component
@@ -403,7 +403,7 @@ impl ChainRig {
 
     /// Whether the rig asks for what a [`crate::crowd::ChainCrowd`] does not step: bone
     /// constraints, sync bones, external forces, a simulation space other than the
-    /// character's, a move scale or a noisy wind (such characters step one
+    /// character's, a move scale, a noisy wind or `kawaii` mode (such characters step one
     /// [`crate::CharacterSim`] each).
     pub fn needs_per_character(&self) -> bool {
         self.has_bone_constraints()
