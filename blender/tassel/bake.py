@@ -8,6 +8,9 @@ import numpy as np
 
 from . import character, pose
 
+# True while a bake plays the frames: the live preview's handlers stand aside.
+BAKING = [False]
+
 # Keyframe.interpolation's enum value for LINEAR.
 _LINEAR = bpy.types.Keyframe.bl_rna.properties["interpolation"].enum_items["LINEAR"].value
 
@@ -54,6 +57,7 @@ def simulate(context, armature, mode, frame_start, frame_end, step_rate, report_
     bases = np.empty((frames, n, 4, 4))
     worlds = np.empty((frames, 4, 4))
     current = scene.frame_current
+    BAKING[0] = True
     try:
         for k in range(frames):
             scene.frame_set(frame_start + k)
@@ -64,6 +68,7 @@ def simulate(context, armature, mode, frame_start, frame_end, step_rate, report_
             if report_progress:
                 report_progress(k + 1, 2 * frames)
     finally:
+        BAKING[0] = False
         scene.frame_set(current)
     animated = skeleton.pose_locals(matrices, bases).astype(np.float32)
     roots = pose.transforms_from_matrices(pose.TO_TASSEL[None] @ worlds)

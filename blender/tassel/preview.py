@@ -59,7 +59,11 @@ def before_frame(scene, _depsgraph=None):
 
 @persistent
 def after_frame(scene, depsgraph=None):
-    """Steps each previewed armature on the evaluated frame and poses its simulated bones."""
+    """Steps each previewed armature on the evaluated frame and poses its simulated bones
+    (not while a bake plays the frames: it reads the animation, which `before_frame` has
+    given back)."""
+    if bake.BAKING[0]:
+        return
     frame = scene.frame_current
     for armature in _armatures(scene):
         try:

@@ -88,3 +88,24 @@ back = max((fox.pose.bones[b].matrix_basis.to_quaternion().rotation_difference(o
 if moved < 1e-3 or back > 1e-6:
     helpers.fail(f"unkeyed tail: turned {moved} rad while previewing, {back} rad after switching it off")
 print(f"OK an unkeyed tail turns {moved:.2f} rad while previewing and gets its own pose back after")
+# A bake while the preview is on reads the animation, not what the preview last wrote on
+# the unkeyed tail: the same keys as a bake with the preview off.
+fox.animation_data.action = untailed
+for b in bones:
+    fox.pose.bones[b].matrix_basis.identity()
+assert bpy.ops.tassel.bake(frame_start=1, frame_end=20) == {"FINISHED"}
+scene.frame_set(20)
+quiet = helpers.world_points(fox, bones)
+fox.animation_data.action = untailed
+for b in bones:
+    fox.pose.bones[b].matrix_basis.identity()
+fox.tassel.preview = True
+for f in range(1, 11):
+    preview_at(f)
+assert bpy.ops.tassel.bake(frame_start=1, frame_end=20) == {"FINISHED"}
+fox.tassel.preview = False
+scene.frame_set(20)
+during = helpers.world_points(fox, bones)
+if gap(quiet, during) > 1e-3:
+    helpers.fail(f"a bake with the preview on differs by {gap(quiet, during)} from one with it off")
+print(f"OK a bake with the preview on reads the animation ({gap(quiet, during):.1e} from one with it off)")
