@@ -38,51 +38,65 @@ class Stepper:
         return self.locals_out
 
 
+# The most bone-frames one bake keys (frames × bones), as `tassel bake`'s limit per clip:
+# every bone is keyed on every frame, ten channels each.
+MAX_BAKE_KEYS = 1 << 23
+# Frames read, converted and stepped together (bounds the scratch memory of a long bake).
+BLOCK = 256
+
+
 def simulate(context, armature, mode, frame_start, frame_end, step_rate, report_progress=None):
     """Plays frames frame_start..frame_end (the first places the solvers, each later one
     steps 1/fps) and returns (skeleton, simulated joints, locals: frames × n × 10). Changes
     nothing but the scene's current frame, which it puts back.
 
-    The animation does not depend on the simulation, so the evaluated poses of all frames
-    are read first (Blender's evaluation, frame by frame), turned into local transforms in
-    one batch, then stepped through Tassel: numpy's cost per call is paid once, not per
-    frame."""
+    The animation does not depend on the simulation, so the evaluated poses of a block of
+    frames are read first (Blender's evaluation, frame by frame), turned into local
+    transforms in one batch, then stepped through Tassel: numpy's cost per call is paid
+    once a block, not once a frame."""
     scene = context.scene
     stepper = Stepper(armature, mode, step_rate)
     skeleton = stepper.skeleton
     n = len(skeleton.names)
     frames = frame_end - frame_start + 1
+    if frames * n > MAX_BAKE_KEYS:
+        raise character.RigError(
+            f"frames {frame_start}–{frame_end} × {n} bones is more than the limit of "
+            f"{MAX_BAKE_KEYS} bone-frames per bake; bake a shorter range"
+        )
     dt = scene.render.fps_base / scene.render.fps
-    matrices = np.empty((frames, n, 4, 4))
-    bases = np.empty((frames, n, 4, 4))
-    worlds = np.empty((frames, 4, 4))
-    current = scene.frame_current
-    BAKING[0] = True
-    try:
-        for k in range(frames):
-            scene.frame_set(frame_start + k)
-            evaluated = armature.evaluated_get(context.evaluated_depsgraph_get())
-            matrices[k] = character.read_pose(evaluated, stepper.order, stepper.buffer)
-            bases[k] = character.read_pose(evaluated, stepper.order, stepper.buffer, "matrix_basis")
-            worlds[k] = np.array(evaluated.matrix_world)
-            if report_progress:
-                report_progress(k + 1, 2 * frames)
-    finally:
-        BAKING[0] = False
-        scene.frame_set(current)
-    animated = skeleton.pose_locals(matrices, bases).astype(np.float32)
-    roots = pose.transforms_from_matrices(pose.TO_TASSEL[None] @ worlds)
+    block = min(BLOCK, frames)
+    matrices = np.empty((block, n, 4, 4))
+    bases = np.empty((block, n, 4, 4))
+    worlds = np.empty((block, 4, 4))
     out = np.empty((frames, n, 10), dtype=np.float32)
+    current = scene.frame_current
     # The character was made at the rest pose at the origin of glTF's axes: the first
     # frame places every solver on this pose and place instead of swinging from there.
     stepper.character.reset()
-    for k in range(frames):
-        try:
-            stepper.character.frame(roots[k], animated[k], out[k], 0.0 if k == 0 else dt)
-        except character.native.TasselError as e:
-            raise character.native.TasselError(f"frame {frame_start + k}: {e}") from None
-        if report_progress:
-            report_progress(frames + k + 1, 2 * frames)
+    BAKING[0] = True
+    try:
+        for start in range(0, frames, block):
+            count = min(block, frames - start)
+            for k in range(count):
+                scene.frame_set(frame_start + start + k)
+                evaluated = armature.evaluated_get(context.evaluated_depsgraph_get())
+                matrices[k] = character.read_pose(evaluated, stepper.order, stepper.buffer)
+                bases[k] = character.read_pose(evaluated, stepper.order, stepper.buffer, "matrix_basis")
+                worlds[k] = np.array(evaluated.matrix_world)
+                if report_progress:
+                    report_progress(start + k + 1, frames)
+            animated = skeleton.pose_locals(matrices[:count], bases[:count]).astype(np.float32)
+            roots = pose.transforms_from_matrices(pose.TO_TASSEL[None] @ worlds[:count])
+            for k in range(count):
+                f = start + k
+                try:
+                    stepper.character.frame(roots[k], animated[k], out[f], 0.0 if f == 0 else dt)
+                except character.native.TasselError as e:
+                    raise character.native.TasselError(f"frame {frame_start + f}: {e}") from None
+    finally:
+        BAKING[0] = False
+        scene.frame_set(current)
     return skeleton, stepper.character.simulated, out
 
 
@@ -176,8 +190,7 @@ def write_action(armature, skeleton, frame_start, locals_):
 
 class Progress:
     """The window manager's progress (0–100 %), and a line on the console each 10 % when
-    headless. Called with (done, total) of the bake's work: reading the frames, then
-    stepping them."""
+    headless. Called with (frames done, frames)."""
 
     def __init__(self, context, label):
         self.wm = context.window_manager
