@@ -47,8 +47,11 @@ def rig_text(settings):
     full = bpy.path.abspath(path)
     if not os.path.isfile(full):
         raise RigError(f"the rig file {full} does not exist")
-    with open(full, encoding="utf-8") as f:
-        return f.read()
+    try:
+        with open(full, encoding="utf-8") as f:
+            return f.read()
+    except (OSError, UnicodeDecodeError) as e:
+        raise RigError(f"the rig file {full} cannot be read as UTF-8 text: {e}") from None
 
 
 def with_step_rate(toml_text, step_rate):
@@ -59,9 +62,12 @@ def with_step_rate(toml_text, step_rate):
     except tomllib.TOMLDecodeError as e:
         raise RigError(f"the rig is not valid TOML: {e}") from None
     if "vrm" in parsed:
-        own = float(parsed["vrm"].get("step_rate", DEFAULT_STEP_RATE)) if isinstance(parsed["vrm"], dict) else None
-        if own != float(step_rate):
-            raise RigError(f"the rig's [vrm] table sets step_rate {own}, the bake asks for {step_rate}")
+        table = parsed["vrm"]
+        own = table.get("step_rate", DEFAULT_STEP_RATE) if isinstance(table, dict) else None
+        if not isinstance(own, (int, float)) or isinstance(own, bool):
+            raise RigError(f"the rig's vrm must be a table with a number step_rate, not {table!r}")
+        if float(own) != float(step_rate):
+            raise RigError(f"the rig's [vrm] table sets step_rate {float(own)}, the bake asks for {float(step_rate)}")
         return toml_text
     if float(step_rate) == DEFAULT_STEP_RATE and toml_text is None:
         return None

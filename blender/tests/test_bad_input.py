@@ -63,6 +63,8 @@ refused("a mesh selected", "'fox' is a mesh", active=mesh, frame_start=1, frame_
 refused("nothing selected", "nothing is active", active=None, frame_start=1, frame_end=40)
 refused("an empty range", "is empty", frame_start=40, frame_end=39)
 refused("a range too long to key", "bone-frames", frame_start=1, frame_end=10_000_000)
+text.from_string(good + "\n[vrm]\nstep_rate = \"fast\"\n")
+refused("a step rate that is not a number", "number step_rate", frame_start=1, frame_end=40)
 text.from_string(good + "\n[vrm]\nstep_rate = 90\n")
 refused("a step rate the rig contradicts", "step_rate 90", frame_start=1, frame_end=40, step_rate=60)
 text.from_string(good)
@@ -70,6 +72,13 @@ fox.tassel.rig_text = None
 refused("no rig", "has no rig", frame_start=1, frame_end=40)
 fox.tassel.rig_file = "/nonexistent/fox.toml"
 refused("a rig file that does not exist", "/nonexistent/fox.toml", frame_start=1, frame_end=40)
+import tempfile  # noqa: E402
+
+binary = os.path.join(tempfile.mkdtemp(), "rig.toml")
+with open(binary, "wb") as f:
+    f.write(b"[[chain]]\nname = \"\xff\xfe\"\n")
+fox.tassel.rig_file = binary
+refused("a rig file that is not UTF-8", "UTF-8", frame_start=1, frame_end=40)
 # Not bad input: a bone scaled to nothing (how animators hide parts) bakes; its subtree
 # sits collapsed on its head, every key finite.
 text.from_string(good)
