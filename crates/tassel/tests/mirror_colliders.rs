@@ -60,8 +60,7 @@ const BALL: &str = "[[collider]]\nname = \"ball\"\nbone = \"arm_L\"\nshape = \"c
 fn placed(sk: &Skeleton, text: &str) -> Vec<tassel::collide::PlacedCollider> {
     let rig = RigSettings::from_toml_str(text).unwrap();
     let mut sim = CharacterSim::new(sk.clone(), &rig).unwrap();
-    sim.frame(&sk.rest().to_vec(), Transform::IDENTITY, 0.0)
-        .unwrap();
+    sim.frame(sk.rest(), Transform::IDENTITY, 0.0).unwrap();
     sim.chain_state().placed_colliders().to_vec()
 }
 
