@@ -3,7 +3,7 @@
 use super::compile::{ChainRig, NONE, VIRTUAL};
 use super::constraint::ChainGroup;
 use super::settings::TimeMode;
-use super::step::{step_chain, step_group, StepInput};
+use super::step::{step_chain, step_group, GroupRef, StepInput};
 use crate::collide::{NearSet, PlacedCollider};
 use crate::controller::Level;
 use crate::dynamics::chain::lanes::twins::{ChainLanes, LaneFrame, ScalarChains};
@@ -865,11 +865,11 @@ fn run_chain(
             }
             TimeMode::Fixed => run_fixed(rig, ci, state, dt, level),
             TimeMode::Kawaii => {
-                let alone = ChainGroup {
-                    chains: vec![ci],
+                let alone = GroupRef {
+                    chains: std::slice::from_ref(&ci),
                     constraints: 0..0,
                 };
-                run_kawaii(rig, &alone, state, component, dt, level);
+                run_kawaii(rig, alone, state, component, dt, level);
             }
         }
     }
@@ -980,13 +980,7 @@ pub(crate) fn slerp_angle(a: Quat, b: Quat) -> f32 {
 /// the frame (a collider shared with another chain stepping at the same time is placed
 /// once).
 fn place_step(rig: &ChainRig, ci: usize, state: &mut ChainState, w: f32) {
-    for p in rig.chains[ci].points.clone() {
-        state.step_targets[p] = state.prev_targets[p].lerp(state.targets[p], w);
-        state.step_normals[p] = normalize_or(
-            state.prev_normals[p].lerp(state.normals[p], w),
-            state.normals[p],
-        );
-    }
+    place_targets(rig, ci, state, w);
     for &c in &rig.chains[ci].colliders {
         if state.step_placed_at[c].to_bits() != w.to_bits() {
             state.step_colliders[c] = state.prev_colliders[c].lerp(&state.colliders[c], w);
@@ -1027,7 +1021,7 @@ fn accelerates(s: &super::ChainSettings) -> bool {
 /// - no output interpolation: the points are where the last substep left them.
 fn run_kawaii(
     rig: &ChainRig,
-    group: &ChainGroup,
+    group: GroupRef,
     state: &mut ChainState,
     component: &Transform,
     dt: f32,
@@ -1044,7 +1038,7 @@ fn run_kawaii(
     let share = h / raw;
     let consumed = ((steps as f32 * h + dropped) / raw).clamp(0.0, 1.0);
     let from = state.last_step_component[lead];
-    for &ci in &group.chains {
+    for &ci in group.chains {
         state.accumulator[ci] = accumulated;
         // The whole frame's motion (carried into this frame's simulation space), shared
         // out below.
@@ -1052,14 +1046,9 @@ fn run_kawaii(
     }
     for k in 1..=steps {
         let alpha = k as f32 / steps as f32;
-        for &ci in &group.chains {
-            for p in rig.chains[ci].points.clone() {
-                state.step_targets[p] = state.prev_targets[p].lerp(state.targets[p], alpha);
-                state.step_normals[p] = normalize_or(
-                    state.prev_normals[p].lerp(state.normals[p], alpha),
-                    state.normals[p],
-                );
-            }
+        for &ci in group.chains {
+            // This frame's colliders, not interpolated ones: as 1.21 places them once a frame.
+            place_targets(rig, ci, state, alpha);
             state.world_near[ci] = world_for(
                 rig,
                 ci,
@@ -1094,37 +1083,23 @@ fn run_kawaii(
             space_in,
             ..
         } = &mut *state;
-        let forces = &*forces;
+        let frame = GroupFrame {
+            targets: step_targets,
+            normals: step_normals,
+            colliders,
+            bounds,
+            space_in,
+            world_near,
+            forces,
+            level,
+            from,
+            component,
+        };
         let input_of = |ci: usize| {
             let s = &rig.chains[ci].settings;
-            let (move_cs, rotate_cs, base) = space_in[ci];
-            StepInput {
-                targets: step_targets,
-                normals: step_normals,
-                colliders,
-                bounds,
-                move_cs: move_cs * share,
-                rotate_cs: Quat::IDENTITY.slerp(rotate_cs, share).normalize(),
-                gravity_cs: gravity_cs(s, component),
-                wind_cs: wind_cs(s, component),
-                dt: h,
-                dt_old: h,
-                fixed: accelerates(s),
-                world: level.filter(|_| world_near[ci]).map(|level| WorldContact {
-                    level,
-                    from,
-                    to: *component,
-                }),
-                push: if forces.reaches(ci) {
-                    &forces.push
-                } else {
-                    &[]
-                },
-                accel: &forces.accel,
-                base,
-            }
+            frame.input(rig, ci, h, h, accelerates(s), Some(share))
         };
-        step_group(rig, group, &input_of, pos, prev, rng, lambda);
+        step_group(rig, group.clone(), &input_of, pos, prev, rng, lambda);
     }
     let advanced = if consumed >= 1.0 - 1e-4 {
         *component
@@ -1137,12 +1112,86 @@ fn run_kawaii(
             from.scale.lerp(component.scale, consumed),
         )
     };
-    for &ci in &group.chains {
+    for &ci in group.chains {
         state.dt_old[ci] = h;
         state.last_step_component[ci] = advanced;
         for p in rig.chains[ci].points.clone() {
             state.dev[p] = state.pos[p] - state.targets[p];
             state.dev_before[p] = state.dev[p];
+        }
+    }
+}
+
+/// Chain `ci`'s step targets and planar normals `w` of the way from last frame's to
+/// this frame's.
+fn place_targets(rig: &ChainRig, ci: usize, state: &mut ChainState, w: f32) {
+    for p in rig.chains[ci].points.clone() {
+        state.step_targets[p] = state.prev_targets[p].lerp(state.targets[p], w);
+        state.step_normals[p] = normalize_or(
+            state.prev_normals[p].lerp(state.normals[p], w),
+            state.normals[p],
+        );
+    }
+}
+
+/// What the chains of a group step on this frame besides their own settings: the targets
+/// and colliders, each chain's share of the character's motion, the world and the
+/// forces. `classic` and `kawaii` frames both build their step inputs from it.
+struct GroupFrame<'a> {
+    targets: &'a [Vec3],
+    normals: &'a [Vec3],
+    colliders: &'a [PlacedCollider],
+    bounds: &'a [Vec4],
+    space_in: &'a [SpaceIn],
+    world_near: &'a [bool],
+    forces: &'a super::force::Forces,
+    level: Option<&'a Level>,
+    from: Transform,
+    component: &'a Transform,
+}
+
+impl<'a> GroupFrame<'a> {
+    /// Chain `ci`'s step of `dt` after one of `dt_old`, gravity as an acceleration when
+    /// `fixed`, taking `share` of the character's motion (`None`: all of it, untouched).
+    fn input(
+        &self,
+        rig: &ChainRig,
+        ci: usize,
+        dt: f32,
+        dt_old: f32,
+        fixed: bool,
+        share: Option<f32>,
+    ) -> StepInput<'a> {
+        let s = &rig.chains[ci].settings;
+        let (mut move_cs, mut rotate_cs, base) = self.space_in[ci];
+        if let Some(share) = share {
+            move_cs *= share;
+            rotate_cs = Quat::IDENTITY.slerp(rotate_cs, share).normalize();
+        }
+        let (from, to) = (self.from, *self.component);
+        StepInput {
+            targets: self.targets,
+            normals: self.normals,
+            colliders: self.colliders,
+            bounds: self.bounds,
+            move_cs,
+            rotate_cs,
+            gravity_cs: gravity_cs(s, self.component),
+            wind_cs: wind_cs(s, self.component),
+            dt,
+            dt_old,
+            fixed,
+            world: self
+                .level
+                .filter(|_| self.world_near[ci])
+                .map(|level| WorldContact { level, from, to }),
+            push: if self.forces.reaches(ci) {
+                &self.forces.push
+            } else {
+                &[]
+            },
+            accel: &self.forces.accel,
+            base,
         }
     }
 }
@@ -1309,37 +1358,20 @@ fn run_group(
                         space_in,
                         ..
                     } = &mut *state;
-                    let forces = &*forces;
-                    let input_of = |ci: usize| {
-                        let s = &rig.chains[ci].settings;
-                        let (move_cs, rotate_cs, base) = space_in[ci];
-                        StepInput {
-                            targets,
-                            normals,
-                            colliders,
-                            bounds,
-                            move_cs,
-                            rotate_cs,
-                            gravity_cs: gravity_cs(s, component),
-                            wind_cs: wind_cs(s, component),
-                            dt,
-                            dt_old: dt_old[ci],
-                            fixed: false,
-                            world: level.filter(|_| world_near[ci]).map(|level| WorldContact {
-                                level,
-                                from,
-                                to: *component,
-                            }),
-                            push: if forces.reaches(ci) {
-                                &forces.push
-                            } else {
-                                &[]
-                            },
-                            accel: &forces.accel,
-                            base,
-                        }
+                    let frame = GroupFrame {
+                        targets,
+                        normals,
+                        colliders,
+                        bounds,
+                        space_in,
+                        world_near,
+                        forces,
+                        level,
+                        from,
+                        component,
                     };
-                    step_group(rig, group, &input_of, pos, prev, rng, lambda);
+                    let input_of = |ci: usize| frame.input(rig, ci, dt, dt_old[ci], false, None);
+                    step_group(rig, group.into(), &input_of, pos, prev, rng, lambda);
                     group.chains.iter().for_each(|&ci| dt_old[ci] = dt);
                 }
                 for &ci in &group.chains {
@@ -1350,7 +1382,7 @@ fn run_group(
                 }
             }
             TimeMode::Fixed => run_fixed_group(rig, group, state, dt, level),
-            TimeMode::Kawaii => run_kawaii(rig, group, state, component, dt, level),
+            TimeMode::Kawaii => run_kawaii(rig, group.into(), state, component, dt, level),
         }
     }
     // Guard: never let a non-finite value out; start again from the pose instead.
@@ -1410,7 +1442,7 @@ fn reset_group(rig: &ChainRig, group: &ChainGroup, state: &mut ChainState, compo
             }
         };
         for _ in 0..s.warmup_steps {
-            step_group(rig, group, &input_of, pos, prev, rng, lambda);
+            step_group(rig, group.into(), &input_of, pos, prev, rng, lambda);
         }
     }
     for &ci in &group.chains {
@@ -1506,7 +1538,7 @@ fn run_fixed_group(
                     base,
                 }
             };
-            step_group(rig, group, &input_of, pos, prev, rng, lambda);
+            step_group(rig, group.into(), &input_of, pos, prev, rng, lambda);
         }
         for &ci in &group.chains {
             state.last_step_component[ci] = comp_b;

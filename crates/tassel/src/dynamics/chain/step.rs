@@ -277,6 +277,23 @@ pub(crate) fn step_chain(
     }
 }
 
+/// A group's chains and its constraints' range, borrowed: a bone-constraint group, or
+/// one chain alone (no constraints) stepped in the same phase order.
+#[derive(Clone)]
+pub(crate) struct GroupRef<'g> {
+    pub chains: &'g [usize],
+    pub constraints: std::ops::Range<usize>,
+}
+
+impl<'g> From<&'g ChainGroup> for GroupRef<'g> {
+    fn from(g: &'g ChainGroup) -> Self {
+        GroupRef {
+            chains: &g.chains,
+            constraints: g.constraints.clone(),
+        }
+    }
+}
+
 /// Advances the chains of a bone-constraint group by one step in KawaiiPhysics 1.20's
 /// phase order: every point integrated; `before` constraint passes; every point
 /// collided; `after` passes; then every point limited and put back at its bone length
@@ -284,14 +301,14 @@ pub(crate) fn step_chain(
 /// `input_of(ci)` is chain `ci`'s step input; the constraints use the first chain's `dt`.
 pub(crate) fn step_group<'a>(
     rig: &ChainRig,
-    group: &ChainGroup,
+    group: GroupRef,
     input_of: &dyn Fn(usize) -> StepInput<'a>,
     pos: &mut [Vec3],
     prev: &mut [Vec3],
     rngs: &mut [SplitMix64],
     lambda: &mut [f32],
 ) {
-    for &ci in &group.chains {
+    for &ci in group.chains {
         let chain = &rig.chains[ci];
         let input = input_of(ci);
         let k = ChainStep::of(&chain.settings, &input);
@@ -317,9 +334,9 @@ pub(crate) fn step_group<'a>(
     }
     let dt = input_of(group.chains[0]).dt;
     let list = &rig.constraints.list[group.constraints.clone()];
-    let lambda = &mut lambda[group.constraints.clone()];
+    let lambda = &mut lambda[group.constraints];
     solve(list, lambda, pos, dt, rig.constraints.before);
-    for &ci in &group.chains {
+    for &ci in group.chains {
         let chain = &rig.chains[ci];
         let input = input_of(ci);
         if chain.colliders.is_empty() && input.world.is_none() {
@@ -336,7 +353,7 @@ pub(crate) fn step_group<'a>(
         }
     }
     solve(list, lambda, pos, dt, rig.constraints.after);
-    for &ci in &group.chains {
+    for &ci in group.chains {
         let chain = &rig.chains[ci];
         let input = input_of(ci);
         let collides = !chain.colliders.is_empty() || input.world.is_some();
