@@ -31,8 +31,13 @@
 //! users take); bevy_vrm1 gets the springs as its components on the same entities (its own
 //! loader needs its MToon renderer).
 //!
+//! **`--animated`**: every joint no spring moves (the body) is turned a little every frame
+//! by a system in `Update`, in every app, as a clip would: the springs' input changes
+//! each frame (without it only the roots move, and tassel-bevy's crowds read only the
+//! bones whose `Transform` changed).
+//!
 //! Run from the repository root:
-//! `cargo run --release --manifest-path bench/bevy_vrm1_vs_tassel/Cargo.toml -- [N] [--avatar] [--frames F] [--rounds R] [--threads T] [--no-colliders]`
+//! `cargo run --release --manifest-path bench/bevy_vrm1_vs_tassel/Cargo.toml -- [N] [--avatar] [--animated] [--frames F] [--rounds R] [--threads T] [--no-colliders]`
 //! (`--threads`: Bevy's compute pool; its default on two cores is one thread).
 
 use bevy::mesh::skinning::SkinnedMesh;
@@ -67,6 +72,20 @@ fn sway(time: Res<Time>, mut q: Query<(&mut Transform, &Sway)>) {
         let x = time.elapsed_secs() + s.0;
         t.translation.x = 0.3 * (2.0 * x).sin();
         t.rotation = Quat::from_rotation_y(0.5 * (1.3 * x).sin());
+    }
+}
+
+/// `--animated`: the joints no spring moves, with their rest rotations, turned a little
+/// every frame before the springs run (as a clip playing on the body would).
+#[derive(Resource, Default)]
+struct Animate(Vec<(Entity, Quat)>);
+
+fn animate(time: Res<Time>, a: Res<Animate>, mut q: Query<&mut Transform>) {
+    let x = time.elapsed_secs();
+    for (k, &(e, rest)) in a.0.iter().enumerate() {
+        if let Ok(mut t) = q.get_mut(e) {
+            t.rotation = rest * Quat::from_rotation_x(0.05 * (2.0 * x + 0.1 * k as f32).sin());
+        }
     }
 }
 
@@ -134,7 +153,8 @@ fn app(engine: Engine, threads: Option<usize>, avatar_folder: Option<&str>) -> A
     )))
     .init_resource::<Marks>()
     .init_resource::<Avatars>()
-    .add_systems(Update, sway);
+    .init_resource::<Animate>()
+    .add_systems(Update, (sway, animate));
     match engine {
         Engine::TasselFixed | Engine::TasselSpec => {
             app.add_plugins(TasselPlugin).add_systems(
@@ -430,6 +450,7 @@ fn main() {
     let mut threads = None;
     let mut colliders = true;
     let mut avatar = false;
+    let mut animated = false;
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         let mut value = || -> usize {
@@ -443,6 +464,7 @@ fn main() {
             "--threads" => threads = Some(value()),
             "--no-colliders" => colliders = false,
             "--avatar" => avatar = true,
+            "--animated" => animated = true,
             _ => n = a.parse().unwrap_or_else(|_| panic!("unknown argument {a}")),
         }
     }
@@ -484,6 +506,25 @@ fn main() {
             joints = spawn_avatar(&mut a, e, n, &sk, &vrm);
         } else {
             joints = spawn(&mut a, e, n, &sk, &vrm);
+        }
+        if animated {
+            let springs: std::collections::HashSet<usize> = vrm
+                .springs
+                .iter()
+                .flat_map(|s| s.joints.iter().map(|j| j.joint))
+                .collect();
+            let driven: Vec<(Entity, Quat)> = a
+                .world()
+                .resource::<Avatars>()
+                .0
+                .iter()
+                .flat_map(|e| {
+                    (1..sk.len())
+                        .filter(|j| !springs.contains(j))
+                        .map(|j| (e[j], sk.rest()[j].rotation))
+                })
+                .collect();
+            a.world_mut().resource_mut::<Animate>().0 = driven;
         }
         // Bound, initialised and warm.
         for _ in 0..30 {
@@ -559,8 +600,9 @@ fn main() {
         .collect();
     let per_joint = |ms: f64| ms * 1e6 / (n * joints) as f64;
     println!(
-        "{n} {} x {joints} spring joints, {} colliders; {rounds} rounds x {frames} frames, apps alternating; {} compute threads; medians",
+        "{n} {}{} x {joints} spring joints, {} colliders; {rounds} rounds x {frames} frames, apps alternating; {} compute threads; medians",
         if avatar { "copies of the built-in avatar (avatar.vrm, skinned, DefaultPlugins without a renderer)" } else { "bare avatars" },
+        if animated { ", the body animated" } else { "" },
         vrm.colliders.len(),
         bevy::tasks::ComputeTaskPool::get().thread_num()
     );
@@ -579,6 +621,27 @@ fn main() {
                 if *e == Engine::TasselFixed { "fixed" } else { "spec" },
                 per_joint(*step)
             ),
+        }
+    }
+    // The plugin's own split of its step (its diagnostics' averages over their history:
+    // the last frames of the last round).
+    for (a, name) in apps[..2].iter().zip(["fixed", "spec"]) {
+        if let Some(store) = a
+            .world()
+            .get_resource::<bevy::diagnostic::DiagnosticsStore>()
+        {
+            let avg = |p| {
+                store
+                    .get(p)
+                    .and_then(|d: &bevy::diagnostic::Diagnostic| d.average())
+                    .unwrap_or(f64::NAN)
+            };
+            println!(
+                "tassel-bevy `{name}` split: read {:.3} ms, solve {:.3} ms, write {:.3} ms",
+                avg(&tassel_bevy::READ_TIME),
+                avg(&tassel_bevy::SOLVE_TIME),
+                avg(&tassel_bevy::WRITE_TIME)
+            );
         }
     }
     let ratio = |i: usize| m[2][1] / m[i][1];

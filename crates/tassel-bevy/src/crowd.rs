@@ -3,9 +3,10 @@
 //! flat buffers, one slot per character.
 
 use crate::convert::{to_bevy, to_tassel, world_of};
+use crate::crowd_bones::{Access, CrowdBone, ReadView, WriteView, WrittenBone, NOT_WRITTEN};
 use bevy::ecs::prelude::*;
 use bevy::platform::collections::{HashMap, HashSet};
-use bevy::prelude::{ChildOf, Transform as BevyTransform};
+use bevy::prelude::{ChildOf, Quat, Transform as BevyTransform};
 use bevy::tasks::ComputeTaskPool;
 use std::sync::Arc;
 use tassel::crowd::{ChainCrowd, CrowdKind, CrowdPose, VrmCrowd};
@@ -58,6 +59,22 @@ pub(crate) struct Kind {
     /// (two characters over one hierarchy): then one thread writes.
     pub(crate) bone_set: HashSet<Entity>,
     pub(crate) shared_bones: bool,
+    /// Per member: how its bones are reached (tagged, or by entity).
+    pub(crate) access: Vec<Access>,
+    /// Per member: its id in its bones' tags (stable while members move).
+    uids: Vec<u32>,
+    /// Id → member index (`u32::MAX`: a free id).
+    member_of: Vec<u32>,
+    /// Ids given back, for the next members.
+    free_uids: Vec<u32>,
+    /// Per joint: whether the crowd reads it, and the crowd's output slot of its rotation
+    /// (or [`NOT_WRITTEN`]).
+    roles: Vec<(bool, u32)>,
+    /// The crowd's output slots per member.
+    slots: usize,
+    /// Every member's output rotations after the frame, member after member (filled for
+    /// the tagged write pass).
+    rotations: Vec<Quat>,
 }
 
 impl Kind {
@@ -81,6 +98,18 @@ impl Kind {
             };
             let written = rig.simulated_joints().to_vec();
             let read_written = read.iter().map(|j| written.binary_search(j).ok()).collect();
+            // Each joint's output slot: the crowd changes only these rotations (the last
+            // slot of a joint wins, as in `write_rotations`).
+            let mut slot = vec![NOT_WRITTEN; n];
+            let rotated: Vec<usize> = match &run {
+                Run::Vrm(c) => c.rig().links.iter().map(|l| l.joint).collect(),
+                Run::Chains(c) => c.rig().rotator_joints().collect(),
+            };
+            for (k, &j) in rotated.iter().enumerate() {
+                slot[j] = k as u32;
+            }
+            let roles = (0..n).map(|j| (read.contains(&j), slot[j])).collect();
+            let slots = rotated.len();
             Ok(Kind {
                 rig: rig.clone(),
                 run,
@@ -99,6 +128,13 @@ impl Kind {
                 held: Vec::new(),
                 bone_set: HashSet::new(),
                 shared_bones: false,
+                access: Vec::new(),
+                uids: Vec::new(),
+                member_of: Vec::new(),
+                free_uids: Vec::new(),
+                roles,
+                slots,
+                rotations: Vec::new(),
             })
         };
         Some(make())
@@ -136,7 +172,48 @@ impl Kind {
         self.wrote.extend(self.written.iter().map(|_| None));
         self.spaces.push(space);
         self.held.push(false);
+        let uid = match self.free_uids.pop() {
+            Some(u) => u,
+            None => {
+                self.member_of.push(u32::MAX);
+                (self.member_of.len() - 1) as u32
+            }
+        };
+        self.member_of[uid as usize] = i as u32;
+        self.uids.push(uid);
+        self.access.push(Access::Entities);
         Some(i)
+    }
+
+    /// Member `i`'s bones with their tags (each bone the crowd reads or writes), or `None`
+    /// when one entity stands for two joints, or the kind's output is a whole pose (VRM
+    /// node constraints turn joints the crowd does not list).
+    fn tags(&self, i: usize, bones: &[Option<Entity>]) -> Option<Vec<(Entity, CrowdBone)>> {
+        if self.whole_pose {
+            return None;
+        }
+        let mut tags = Vec::new();
+        let mut seen = HashSet::new();
+        for (j, (&(reads, slot), bone)) in self.roles.iter().zip(bones).enumerate() {
+            let Some(e) = *bone else { continue };
+            if !reads && slot == NOT_WRITTEN {
+                continue;
+            }
+            if !seen.insert(e) {
+                return None;
+            }
+            tags.push((
+                e,
+                CrowdBone {
+                    kind: key(&self.rig),
+                    uid: self.uids[i],
+                    joint: j as u32,
+                    reads,
+                    slot,
+                },
+            ));
+        }
+        Some(tags)
     }
 
     /// Removes member `i`; the last member takes its index: returns that member's entity
@@ -159,6 +236,13 @@ impl Kind {
         self.roots.swap_remove(i);
         self.spaces.swap_remove(i);
         self.held.swap_remove(i);
+        self.access.swap_remove(i);
+        let uid = self.uids.swap_remove(i);
+        self.member_of[uid as usize] = u32::MAX;
+        self.free_uids.push(uid);
+        if i != last {
+            self.member_of[self.uids[i] as usize] = i as u32;
+        }
         swap_remove_run(&mut self.locals, n, i);
         swap_remove_run(&mut self.read_bones, self.read.len(), i);
         swap_remove_run(&mut self.write_bones, self.written.len(), i);
@@ -220,6 +304,7 @@ impl Kind {
         let chunk = members.div_ceil(parts(pool));
         let (read, read_written) = (&self.read, &self.read_written);
         let (bones, wrote, spaces) = (&self.read_bones, &self.wrote, &self.spaces);
+        let access = &self.access;
         let (locals, roots) = (&mut self.locals, &mut self.roots);
         pool.scope(|s| {
             for (c, (locals, roots)) in locals
@@ -234,14 +319,66 @@ impl Kind {
                     bones: &bones[a * r..b * r],
                     wrote: &wrote[a * w..b * w],
                     spaces: &spaces[a..b],
+                    access: &access[a..b],
                 };
                 s.spawn(async move { part.read(locals, roots, transforms, parents) });
             }
         });
     }
 
-    /// Writes every member's simulated bones (but a held member's: its bones keep their
-    /// animated pose), the members shared out over Bevy's compute task pool.
+    /// The tagged read pass's view of this kind.
+    pub(crate) fn read_view(&mut self) -> ReadView<'_> {
+        ReadView {
+            kind: key(&self.rig),
+            joints: self.rig.skeleton().len(),
+            member_of: &self.member_of,
+            access: &self.access,
+            locals: &mut self.locals,
+        }
+    }
+
+    /// The tagged write pass's view of this kind: its members' output rotations gathered
+    /// (when a member is tagged).
+    pub(crate) fn write_view(&mut self) -> WriteView<'_> {
+        let tagged = self.access.contains(&Access::Tags);
+        self.rotations.resize(
+            if tagged {
+                self.members.len() * self.slots
+            } else {
+                0
+            },
+            Quat::IDENTITY,
+        );
+        if tagged {
+            // The lengths agree (members × slots), so this cannot fail.
+            let _ = match &self.run {
+                Run::Vrm(c) => c.rotations(&mut self.rotations),
+                Run::Chains(c) => c.rotations(&mut self.rotations),
+            };
+        }
+        WriteView {
+            kind: key(&self.rig),
+            member_of: &self.member_of,
+            access: &self.access,
+            held: &self.held,
+            slots: self.slots,
+            rotations: &self.rotations,
+        }
+    }
+
+    /// Members whose tags were inserted this frame reach their bones through them from the
+    /// next one.
+    pub(crate) fn tags_arrived(&mut self) {
+        for a in &mut self.access {
+            if *a == Access::Tagging {
+                *a = Access::Tags;
+            }
+        }
+    }
+
+    /// Writes the simulated bones of every member not tagged (a tagged member's are written
+    /// by the tagged pass) but a held member's (its bones keep their animated pose), the
+    /// members shared out over Bevy's compute task pool.
     pub(crate) fn write(&mut self, transforms: &mut Query<&mut BevyTransform>) {
         let (members, w) = (self.members.len(), self.written.len());
         if members == 0 || w == 0 {
@@ -261,7 +398,10 @@ impl Kind {
             locals: &self.locals,
             written: &self.written,
         };
-        let (bones, held) = (&self.write_bones, &self.held);
+        if self.access.iter().all(|&a| a == Access::Tags) {
+            return;
+        }
+        let (bones, held, access) = (&self.write_bones, &self.held, &self.access);
         let transforms = &*transforms;
         pool.scope(|s| {
             for (c, (wrote, scratch)) in self
@@ -274,10 +414,11 @@ impl Kind {
                 let count = wrote.len() / w;
                 let bones = &bones[first * w..(first + count) * w];
                 let held = &held[first..first + count];
+                let access = &access[first..first + count];
                 let out = &out;
                 s.spawn(async move {
                     for m in 0..count {
-                        if held[m] {
+                        if held[m] || access[m] == Access::Tags {
                             continue;
                         }
                         let pose = out.pose(first + m, scratch);
@@ -351,6 +492,7 @@ struct Members<'k> {
     bones: &'k [Option<Entity>],
     wrote: &'k [Option<Transform>],
     spaces: &'k [Option<Entity>],
+    access: &'k [Access],
 }
 
 impl Members<'_> {
@@ -372,6 +514,10 @@ impl Members<'_> {
         );
         for (m, root) in roots.iter_mut().enumerate() {
             *root = world_of(self.spaces[m], transforms, parents);
+            if self.access[m] == Access::Tags {
+                // Its changed bones are read by the tagged pass.
+                continue;
+            }
             let locals = &mut locals[m * n..(m + 1) * n];
             let bones = &self.bones[m * r..(m + 1) * r];
             let wrote = &self.wrote[m * w..(m + 1) * w];
@@ -416,6 +562,8 @@ pub(crate) struct Crowds {
     pub(crate) members: HashMap<Entity, (usize, usize)>,
     /// Kinds that cannot run as a crowd, or whose crowd failed to build (checked once).
     pub(crate) not_crowds: HashMap<usize, std::sync::Weak<CharacterRig>>,
+    /// The bones tagged for a member (a [`CrowdBone`] each): a bone is tagged once.
+    pub(crate) tagged: HashSet<Entity>,
 }
 
 /// The key of a compiled rig.
@@ -432,6 +580,7 @@ impl Crowds {
         rig: &Arc<CharacterRig>,
         bones: &[Option<Entity>],
         space: Option<Entity>,
+        commands: &mut Commands,
     ) -> Option<usize> {
         let k = key(rig);
         if self
@@ -461,6 +610,20 @@ impl Crowds {
             return None;
         };
         self.members.insert(entity, (k, i));
+        // Its bones get their tags unless one is another member's too.
+        if let Some(tags) = kind.tags(i, bones) {
+            if tags.iter().all(|(e, _)| !self.tagged.contains(e)) {
+                for (e, tag) in tags {
+                    self.tagged.insert(e);
+                    if tag.slot == NOT_WRITTEN {
+                        commands.entity(e).try_insert(tag);
+                    } else {
+                        commands.entity(e).try_insert((tag, WrittenBone));
+                    }
+                }
+                kind.access[i] = Access::Tagging;
+            }
+        }
         Some(i)
     }
 
@@ -473,9 +636,22 @@ impl Crowds {
     /// Removes `entity` from its crowd, if it is in one: returns the member that took its
     /// index (entity and new index), for its component to follow. A kind left empty is
     /// dropped (and with it the crowd's hold on the compiled rig).
-    pub(crate) fn leave(&mut self, entity: Entity) -> Option<(Entity, usize)> {
+    pub(crate) fn leave(
+        &mut self,
+        entity: Entity,
+        commands: &mut Commands,
+    ) -> Option<(Entity, usize)> {
         let (k, i) = self.members.remove(&entity)?;
         let kind = self.kinds.get_mut(&k)?;
+        if kind.access[i] != Access::Entities {
+            let (r, w) = (kind.read.len(), kind.written.len());
+            let read = kind.read_bones[i * r..(i + 1) * r].iter().flatten();
+            for &e in read.chain(&kind.write_bones[i * w..(i + 1) * w]) {
+                if self.tagged.remove(&e) {
+                    commands.entity(e).try_remove::<(CrowdBone, WrittenBone)>();
+                }
+            }
+        }
         let moved = kind.swap_remove(i);
         if kind.members.is_empty() {
             self.kinds.remove(&k);

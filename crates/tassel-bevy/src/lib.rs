@@ -49,6 +49,7 @@ mod character;
 mod controller;
 mod convert;
 mod crowd;
+mod crowd_bones;
 #[cfg(feature = "gizmos")]
 mod gizmos;
 mod spawn;

@@ -13,6 +13,7 @@
 use crate::character::TasselCharacter;
 use crate::convert::{to_bevy, to_tassel, world_of};
 use crate::crowd::Crowds;
+use crate::crowd_bones::{read_tagged, write_tagged, CrowdBone, ReadView, WriteView, WrittenBone};
 use crate::TasselError;
 use bevy::diagnostic::{Diagnostic, DiagnosticPath, Diagnostics};
 use bevy::ecs::prelude::*;
@@ -106,11 +107,24 @@ fn report(
     }
 }
 
+/// Every `Transform` (looked up by entity), the crowd members' tagged bones whose
+/// `Transform` changed since the step last ran (read), and the tagged bones (written).
+type Transforms<'w, 's> = ParamSet<
+    'w,
+    's,
+    (
+        Query<'static, 'static, &'static mut Transform>,
+        Query<'static, 'static, (&'static CrowdBone, &'static Transform), Changed<Transform>>,
+        Query<'static, 'static, (&'static CrowdBone, &'static mut Transform), With<WrittenBone>>,
+    ),
+>;
+
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn step_characters(
     time: Res<Time>,
+    mut commands: Commands,
     mut characters: Query<(Entity, &mut TasselCharacter)>,
-    mut transforms: Query<&mut Transform>,
+    mut transforms: Transforms,
     parents: Query<&ChildOf>,
     mut errors: MessageWriter<TasselError>,
     mut crowds: ResMut<Crowds>,
@@ -124,7 +138,7 @@ pub(crate) fn step_characters(
     // Characters gone (despawned, or rebound with another rig or mode) leave their crowd;
     // the member that takes a leaver's index follows it.
     for entity in removed.read() {
-        if let Some((moved, i)) = crowds.leave(entity) {
+        if let Some((moved, i)) = crowds.leave(entity, &mut commands) {
             if let Ok((_, mut c)) = characters.get_mut(moved) {
                 c.slot = Some(i);
             }
@@ -136,7 +150,7 @@ pub(crate) fn step_characters(
     for (entity, mut c) in &mut characters {
         if c.sim.is_none() && c.slot.is_none() {
             let rig = c.rig.clone();
-            match crowds.join(entity, &rig, &c.bones, c.space) {
+            match crowds.join(entity, &rig, &c.bones, c.space, &mut commands) {
                 Some(i) => c.slot = Some(i),
                 // Not a crowd after all (its crowd failed to build): its own sim.
                 None => c.sim = Some(tassel::CharacterSim::from_rig(rig)),
@@ -151,6 +165,7 @@ pub(crate) fn step_characters(
     }
     // Read: the characters on their own sims, then every crowd's members (in parallel).
     {
+        let transforms = transforms.p0();
         let transforms = transforms.as_readonly();
         for (_, mut c) in &mut characters {
             if c.sim.is_none() {
@@ -165,6 +180,10 @@ pub(crate) fn step_characters(
         for kind in crowds.kinds.values_mut() {
             kind.read(&transforms, &parents);
         }
+    }
+    {
+        let mut views: Vec<ReadView> = crowds.kinds.values_mut().map(|k| k.read_view()).collect();
+        read_tagged(&mut views, &transforms.p1());
     }
     let read = Instant::now();
     // Step: the characters on their own sims in parallel, then each crowd (its lane
@@ -200,7 +219,14 @@ pub(crate) fn step_characters(
     let solved = Instant::now();
     // Write: every crowd's members, then the characters on their own sims; errors.
     for kind in crowds.kinds.values_mut() {
-        kind.write(&mut transforms);
+        kind.write(&mut transforms.p0());
+    }
+    {
+        let views: Vec<WriteView> = crowds.kinds.values_mut().map(|k| k.write_view()).collect();
+        write_tagged(&views, &mut transforms.p2());
+    }
+    for kind in crowds.kinds.values_mut() {
+        kind.tags_arrived();
     }
     for (entity, mut c) in &mut characters {
         if c.result.is_none() && c.last_error.is_none() && c.sim.is_none() {
@@ -213,7 +239,7 @@ pub(crate) fn step_characters(
         }
         c.last_error = None;
         if let Some(sim) = c.sim.take() {
-            write_pose(c, &sim.pose().locals, &mut transforms);
+            write_pose(c, &sim.pose().locals, &mut transforms.p0());
             c.sim = Some(sim);
         }
     }

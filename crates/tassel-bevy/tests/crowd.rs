@@ -371,3 +371,70 @@ fn two_characters_over_one_hierarchy_write_their_bones_in_turn() {
     assert!(in_crowd(&app, outer) && in_crowd(&app, inner));
     assert!(app.world().resource::<Errors>().0.is_empty());
 }
+
+/// Crowd members read their animated bones by walking the bones whose `Transform` changed
+/// since the plugin last ran (Bevy's change ticks); characters on their own sims look every
+/// bone up and compare it with what they wrote. Both must see the same input: a bone
+/// animated every frame (the skeleton's root), a simulated bone animated for a while and
+/// then left alone (its input stays its last animated pose, not the simulated one), and a
+/// simulated bone set once.
+#[test]
+fn animated_bones_reach_crowd_members_as_they_reach_own_sims() {
+    #[derive(Resource)]
+    struct Drive {
+        bones: Vec<Vec<Entity>>,
+        joints: [usize; 2],
+        frame: u32,
+        on: bool,
+    }
+    fn drive(mut d: ResMut<Drive>, mut q: Query<&mut Transform>) {
+        d.frame += 1;
+        if !d.on {
+            return;
+        }
+        let (f, [a, b]) = (d.frame as f32, d.joints);
+        for bones in &d.bones {
+            q.get_mut(bones[0]).unwrap().rotation = Quat::from_rotation_z(0.4 * (0.21 * f).sin());
+            if (20..40).contains(&d.frame) {
+                q.get_mut(bones[a]).unwrap().rotation =
+                    Quat::from_rotation_x(0.5 * (0.3 * f).sin());
+            }
+            if d.frame == 50 {
+                q.get_mut(bones[b]).unwrap().rotation = Quat::from_rotation_z(0.6);
+            }
+        }
+    }
+    let run = |on: bool| -> u64 {
+        let (mut app, pairs, simulated) = crowd_app(2, 6, SimMode::Fixed);
+        let bones = pairs
+            .iter()
+            .flat_map(|p| [p.crowd_bones.clone(), p.twin_bones.clone()])
+            .collect();
+        app.insert_resource(Drive {
+            bones,
+            joints: [simulated[0], simulated[3]],
+            frame: 0,
+            on,
+        })
+        .add_systems(
+            PostUpdate,
+            drive
+                .after(bevy::app::AnimationSystems)
+                .before(TasselSystems::Step),
+        );
+        let mut digest = 0xcbf2_9ce4_8422_2325u64;
+        for frame in 1..=90 {
+            app.update();
+            if frame > 3 {
+                let (b, _) = compare(&app, &pairs, &simulated, frame);
+                for x in b.iter().flatten() {
+                    digest = (digest ^ u64::from(*x)).wrapping_mul(0x100_0000_01b3);
+                }
+            }
+        }
+        assert!(pairs.iter().all(|p| in_crowd(&app, p.crowd)));
+        assert!(app.world().resource::<Errors>().0.is_empty());
+        digest
+    };
+    assert_ne!(run(true), run(false), "the animation reaches the springs");
+}

@@ -59,8 +59,19 @@ fn assert_crowd_matches(
                 locals: &inputs[i].1,
             })
             .unwrap();
+        // Every character's rotations in one walk, against each one's own sim.
+        let rotators: Vec<usize> = chains.rotator_joints().collect();
+        let mut all = vec![glam::Quat::IDENTITY; n * rotators.len()];
+        crowd.rotations(&mut all).unwrap();
         for (i, sim) in sims.iter_mut().enumerate() {
             let pose = sim.frame(&inputs[i].1, inputs[i].0, dt).unwrap();
+            for (k, &j) in rotators.iter().enumerate() {
+                assert_eq!(
+                    all[i * rotators.len() + k].to_array().map(f32::to_bits),
+                    pose.locals[j].rotation.to_array().map(f32::to_bits),
+                    "frame {f}, character {i}, rotator {k}: rotations()"
+                );
+            }
             locals.copy_from_slice(&inputs[i].1);
             crowd.write_pose(i, &mut locals, &mut models).unwrap();
             for j in 0..sk.len() {

@@ -461,8 +461,26 @@ fn vrm_crowd_removes_and_adds_characters() {
                     locals: &inputs[i].1,
                 })
                 .unwrap();
+            // Every character's link rotations in one walk, against each one's own sim.
+            let links = &crowd.rig().links;
+            let mut all = vec![Quat::IDENTITY; people.len() * links.len()];
+            crowd.rotations(&mut all).unwrap();
+            assert!(
+                crowd.rotations(&mut all[1..]).is_err(),
+                "a wrong length is refused"
+            );
             for (k, (id, sim)) in people.iter_mut().enumerate() {
                 let pose = sim.frame(&inputs[k].1, inputs[k].0, 1.0 / 60.0).unwrap();
+                for (l, link) in links.iter().enumerate() {
+                    assert_eq!(
+                        all[k * links.len() + l].to_array().map(f32::to_bits),
+                        pose.locals[link.joint]
+                            .rotation
+                            .to_array()
+                            .map(f32::to_bits),
+                        "{mode:?} frame {f}: character {id}, link {l}: rotations()"
+                    );
+                }
                 locals.copy_from_slice(&inputs[k].1);
                 crowd.write_pose(k, &mut locals, &mut models).unwrap();
                 for j in 0..sk.len() {

@@ -12,7 +12,7 @@ use crate::lanes::{Isa, SimdUse, LANES};
 use crate::math::Transform;
 use crate::pose::LocalToModelJob;
 use crate::skeleton::Skeleton;
-use glam::Vec3;
+use glam::{Quat, Vec3};
 use std::sync::Arc;
 
 /// Many characters with the same bone chains, advanced together.
@@ -222,6 +222,25 @@ impl ChainCrowd {
             return None;
         }
         Some(self.packs[i / LANES].out[point].get(i % LANES))
+    }
+
+    /// Character `i`'s simulated local rotation of rotator `k` (in
+    /// [`ChainRig::rotator_joints`] order) after the last frame: what
+    /// [`Self::write_rotations`] writes into that joint.
+    pub fn rotation(&self, i: usize, k: usize) -> Option<Quat> {
+        if i >= self.len || k >= self.rig.rotators.len() {
+            return None;
+        }
+        Some(self.packs[i / LANES].out_rotation[k].get(i % LANES))
+    }
+
+    /// Every character's rotator rotations (as [`Self::rotation`] gives them), character
+    /// after character: `out[i * rotators + k]` is character `i`'s rotation `k`, `out`
+    /// being [`Self::len`] × the rig's rotators long. One walk over the lane groups.
+    /// Never allocates.
+    pub fn rotations(&self, out: &mut [Quat]) -> Result<()> {
+        let groups = self.packs.iter().map(|p| p.out_rotation.as_slice());
+        super::gather_rotations(groups, self.len, self.rig.rotators.len(), out)
     }
 
     /// Character `i`'s pose after the last frame: `locals` holds its animated pose of that

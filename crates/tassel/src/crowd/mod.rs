@@ -53,6 +53,37 @@ impl CrowdKind {
     }
 }
 
+/// Every character's output rotations into `out`, character after character, slot after
+/// slot (`out[i * slots + k]`: character `i`'s rotation `k`), from the lane groups'
+/// `out_rotation` lists (`slots` each): what `rotation(i, k)` gives for every `i` and `k`,
+/// in one walk over the groups.
+fn gather_rotations<'p>(
+    groups: impl Iterator<Item = &'p [lanes::Q]>,
+    len: usize,
+    slots: usize,
+    out: &mut [glam::Quat],
+) -> crate::error::Result<()> {
+    if out.len() != len * slots {
+        return Err(Error::LengthMismatch {
+            what: "rotations",
+            expected: len * slots,
+            got: out.len(),
+        });
+    }
+    for (g, rotations) in groups.enumerate() {
+        let lanes = (len - g * lanes::LANES).min(lanes::LANES);
+        let first = g * lanes::LANES * slots;
+        for (k, q) in rotations.iter().enumerate() {
+            // The lanes' arrays read in place (`Q::get` copies each array per lane).
+            let (x, y, z, w) = (&q.x.0, &q.y.0, &q.z.0, &q.w.0);
+            for l in 0..lanes {
+                out[first + l * slots + k] = glam::Quat::from_xyzw(x[l], y[l], z[l], w[l]);
+            }
+        }
+    }
+    Ok(())
+}
+
 /// A lane group as a crowd's frame holds its bad characters: its list of held
 /// characters, and one lane's whole state out and back in.
 trait Group {

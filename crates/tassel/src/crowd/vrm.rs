@@ -227,6 +227,15 @@ impl VrmCrowd {
         Some(self.packs[i / LANES].out_rotation[link].get(i % LANES))
     }
 
+    /// Every character's link rotations (as [`Self::rotation`] gives them), character after
+    /// character: `out[i * links + k]` is character `i`'s rotation of link `k`, `out` being
+    /// [`Self::len`] × the rig's links long. One walk over the lane groups: the way to read
+    /// them all. Never allocates.
+    pub fn rotations(&self, out: &mut [Quat]) -> Result<()> {
+        let groups = self.packs.iter().map(|p| p.out_rotation.as_slice());
+        super::gather_rotations(groups, self.len, self.rig.links.len(), out)
+    }
+
     /// Character `i`'s current tail of link `link`, world space (or its spring's centre
     /// space when the spring has a centre), as the last frame left it.
     pub fn tail(&self, i: usize, link: usize) -> Option<Vec3> {

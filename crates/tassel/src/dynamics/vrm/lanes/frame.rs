@@ -721,18 +721,10 @@ impl Ctx<'_> {
     ) {
         let plan = self.plan;
         let opts = &self.rig.options;
-        // Last frame's pose for the next steps: the animated locals, with the rest
-        // rotations a reset wrote into the spring joints.
-        for slot in 0..plan.joints.len() {
-            let mut kept = s.locals[slot];
-            if let Some(i) = plan.link_at[slot] {
-                kept.r = Q::select(reset, Q::splat(plan.links[i].rest_local.rotation), kept.r);
-            }
-            pack.prev_locals[slot] = kept;
-        }
         let pass = on_frame.not();
         if pass == M::NONE {
             pack.out_rotation.copy_from_slice(&pack.rotation);
+            self.keep_locals(pack, s, reset);
             return;
         }
         let mut a = [0.0f32; LANES];
@@ -763,6 +755,26 @@ impl Ctx<'_> {
         std::mem::swap(&mut pack.current_tail, &mut s.kept_current);
         std::mem::swap(&mut pack.prev_tail, &mut s.kept_prev);
         std::mem::swap(&mut pack.rotation, &mut s.kept_rotation);
+        self.keep_locals(pack, s, reset);
+    }
+
+    /// This frame's pose kept for the next frame's steps (`pack.prev_locals`): the
+    /// animated locals, with the rest rotations a reset wrote into the spring joints. The
+    /// scratch's buffer is taken, not copied (a whole pose of lanes per group and frame):
+    /// the scratch gets the old one, which the next group's gather fills again. So the
+    /// last use of `s.locals` in a group's frame.
+    #[inline(always)]
+    fn keep_locals(&self, pack: &mut Pack, s: &mut Scratch, reset: M) {
+        let plan = self.plan;
+        if reset.any() {
+            for slot in 0..plan.joints.len() {
+                if let Some(i) = plan.link_at[slot] {
+                    let kept = &mut s.locals[slot];
+                    kept.r = Q::select(reset, Q::splat(plan.links[i].rest_local.rotation), kept.r);
+                }
+            }
+        }
+        std::mem::swap(&mut pack.prev_locals, &mut s.locals);
     }
 
     /// The specification's initialisation for the lanes in `lanes`: joints at their rest

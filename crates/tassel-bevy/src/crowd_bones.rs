@@ -1,0 +1,143 @@
+//! Crowd members' bones read and written by walking them, not by looking each one up.
+//!
+//! A member whose bones are its own (no other member reads or writes one of them, and its
+//! kind's output is rotations only: no VRM node constraints) tags each bone it reads or
+//! writes with a [`CrowdBone`] (its kind, the member's stable id, the joint, the crowd's
+//! output slot of its rotation), and each bone it writes also with a [`WrittenBone`]. The
+//! read pass walks the tagged bones whose `Transform` changed since the step system last
+//! ran (Bevy's change ticks: the plugin's own writes are not changes to it, so a bone no
+//! animation drives keeps its last animated pose as input, as the per-entity path's
+//! comparison with what the plugin wrote does); the write pass walks the written bones in
+//! the pool's threads and sets each one's rotation from the crowd's output, gathered once
+//! per frame member after member. Both walk Bevy's tables in order, and the read touches
+//! nothing of a bone no animation moved.
+//!
+//! The tags arrive with the commands applied after the step system, so a member reads and
+//! writes through its entities on the frame it joins (which also reads its whole pose,
+//! changed or not), then through its tags. A member sharing a bone with another one
+//! (two characters over one hierarchy) keeps the per-entity path.
+
+use crate::convert::to_tassel;
+use bevy::ecs::prelude::*;
+use bevy::prelude::{Quat, Transform as BevyTransform};
+use tassel::Transform;
+
+/// No written slot: the bone is read only.
+pub(crate) const NOT_WRITTEN: u32 = u32::MAX;
+
+/// A crowd member's bone: what the tagged read and write passes need to find its slot.
+#[derive(Component, Clone, Copy, Debug)]
+pub(crate) struct CrowdBone {
+    /// The member's kind ([`crate::crowd::key`] of its compiled rig).
+    pub(crate) kind: usize,
+    /// The member's id in its kind (its index follows through `Kind::member_of`).
+    pub(crate) uid: u32,
+    /// The joint this bone is.
+    pub(crate) joint: u32,
+    /// Whether the crowd reads this joint's animated pose.
+    pub(crate) reads: bool,
+    /// The crowd's output slot of its rotation, or [`NOT_WRITTEN`].
+    pub(crate) slot: u32,
+}
+
+/// A tagged bone the crowd writes (beside its [`CrowdBone`]): the write pass walks only
+/// these.
+#[derive(Component, Clone, Copy, Debug)]
+pub(crate) struct WrittenBone;
+
+/// How a crowd member's bones are reached.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+pub(crate) enum Access {
+    /// By entity lookups, always (a bone shared with another member).
+    Entities,
+    /// By entity lookups this frame; its tags are being inserted.
+    Tagging,
+    /// By its tagged bones.
+    Tags,
+}
+
+/// One kind's buffers as the tagged read pass fills them.
+pub(crate) struct ReadView<'k> {
+    pub(crate) kind: usize,
+    /// Joints per member.
+    pub(crate) joints: usize,
+    pub(crate) member_of: &'k [u32],
+    pub(crate) access: &'k [Access],
+    pub(crate) locals: &'k mut [Transform],
+}
+
+/// One kind's output as the tagged write pass copies it.
+pub(crate) struct WriteView<'k> {
+    pub(crate) kind: usize,
+    pub(crate) member_of: &'k [u32],
+    pub(crate) access: &'k [Access],
+    pub(crate) held: &'k [bool],
+    /// Output slots per member.
+    pub(crate) slots: usize,
+    /// Every member's output rotations, member after member.
+    pub(crate) rotations: &'k [Quat],
+}
+
+/// Reads every tagged bone that changed since the step system last ran into its member's
+/// `locals`.
+pub(crate) fn read_tagged(
+    views: &mut [ReadView<'_>],
+    bones: &Query<(&CrowdBone, &BevyTransform), Changed<BevyTransform>>,
+) {
+    if views.is_empty() {
+        return;
+    }
+    let mut at = 0;
+    for (bone, t) in bones {
+        if !bone.reads {
+            continue;
+        }
+        if views[at].kind != bone.kind {
+            match views.iter().position(|v| v.kind == bone.kind) {
+                Some(i) => at = i,
+                None => continue,
+            }
+        }
+        let v = &mut views[at];
+        let Some(&m) = v.member_of.get(bone.uid as usize) else {
+            continue;
+        };
+        let m = m as usize;
+        if v.access.get(m) != Some(&Access::Tags) {
+            continue;
+        }
+        v.locals[m * v.joints + bone.joint as usize] = to_tassel(t);
+    }
+}
+
+/// Writes every tagged, written bone of a member that stepped (not held) from its
+/// kind's output, in the compute pool's threads. Only the rotation: a crowd turns the
+/// bones it writes, and their translation and scale are already this frame's animated
+/// ones (read from them, or unchanged since they were), which is what the per-entity
+/// path writes back with the rotation.
+pub(crate) fn write_tagged(
+    views: &[WriteView<'_>],
+    bones: &mut Query<(&CrowdBone, &mut BevyTransform), With<WrittenBone>>,
+) {
+    if views.is_empty() {
+        return;
+    }
+    bones.par_iter_mut().for_each(|(bone, mut t)| {
+        if bone.slot == NOT_WRITTEN {
+            return;
+        }
+        let Some(v) = views.iter().find(|v| v.kind == bone.kind) else {
+            return;
+        };
+        let Some(&m) = v.member_of.get(bone.uid as usize) else {
+            return;
+        };
+        let m = m as usize;
+        if v.access.get(m) != Some(&Access::Tags) || v.held[m] {
+            return;
+        }
+        if let Some(&r) = v.rotations.get(m * v.slots + bone.slot as usize) {
+            t.rotation = r;
+        }
+    });
+}
