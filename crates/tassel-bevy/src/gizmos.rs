@@ -70,7 +70,7 @@ fn draw(mut gizmos: Gizmos, characters: Query<&TasselCharacter>) {
                 }
                 PlacedVrmCollider::Capsule {
                     head, tail, radius, ..
-                } => capsule(&mut gizmos, head, tail, radius),
+                } => capsule(&mut gizmos, head, tail, radius, radius),
                 _ => {}
             }
         }
@@ -84,7 +84,16 @@ fn shape(gizmos: &mut Gizmos, shape: &Shape, at: Vec3, rotation: Quat) {
         }
         Shape::Capsule { radius, length } => {
             let half = rotation * Vec3::Y * (0.5 * length);
-            capsule(gizmos, at - half, at + half, radius);
+            capsule(gizmos, at - half, at + half, radius, radius);
+        }
+        Shape::TaperedCapsule {
+            radius0,
+            radius1,
+            length,
+        } => {
+            // `radius0` at the +Y end.
+            let half = rotation * Vec3::Y * (0.5 * length);
+            capsule(gizmos, at + half, at - half, radius0, radius1);
         }
         Shape::Box { half_extents } => {
             gizmos.cube(
@@ -98,13 +107,15 @@ fn shape(gizmos: &mut Gizmos, shape: &Shape, at: Vec3, rotation: Quat) {
     }
 }
 
-fn capsule(gizmos: &mut Gizmos, a: Vec3, b: Vec3, radius: f32) {
-    gizmos.sphere(Isometry3d::from_translation(a), radius, COLLIDER);
-    gizmos.sphere(Isometry3d::from_translation(b), radius, COLLIDER);
+/// A capsule from `a` (radius `ra`) to `b` (radius `rb`): the end balls and four lines
+/// along its side (a tapered capsule's radius changes linearly along the axis).
+fn capsule(gizmos: &mut Gizmos, a: Vec3, b: Vec3, ra: f32, rb: f32) {
+    gizmos.sphere(Isometry3d::from_translation(a), ra, COLLIDER);
+    gizmos.sphere(Isometry3d::from_translation(b), rb, COLLIDER);
     let axis = (b - a).normalize_or(Vec3::Y);
-    let side = axis.any_orthonormal_vector() * radius;
+    let side = axis.any_orthonormal_vector();
     let up = axis.cross(side);
     for offset in [side, -side, up, -up] {
-        gizmos.line(a + offset, b + offset, COLLIDER);
+        gizmos.line(a + offset * ra, b + offset * rb, COLLIDER);
     }
 }

@@ -25,6 +25,17 @@ pub enum Outline {
         /// Radius.
         radius: f32,
     },
+    /// A tapered capsule: two end balls of different radii and the cone between them.
+    TaperedCapsule {
+        /// One end.
+        a: Vec3,
+        /// The other end.
+        b: Vec3,
+        /// Radius at `a`.
+        radius_a: f32,
+        /// Radius at `b`.
+        radius_b: f32,
+    },
     /// An oriented box: its eight corners.
     Box {
         /// Corners, index bits (x, y, z) = (1, 2, 4) set for the + side.
@@ -45,6 +56,12 @@ impl Outline {
         match *self {
             Outline::Sphere { center, radius } => vec![(center, radius)],
             Outline::Capsule { a, b, radius } => vec![(a, radius), (b, radius)],
+            Outline::TaperedCapsule {
+                a,
+                b,
+                radius_a,
+                radius_b,
+            } => vec![(a, radius_a), (b, radius_b)],
             Outline::Box { corners } => corners.iter().map(|c| (*c, 0.0)).collect(),
             Outline::Plane { point, .. } => vec![(point, 0.0)],
         }
@@ -206,6 +223,20 @@ pub fn outline(c: &PlacedCollider) -> Outline {
                 a: t.translation - axis,
                 b: t.translation + axis,
                 radius,
+            }
+        }
+        Shape::TaperedCapsule {
+            radius0,
+            radius1,
+            length,
+        } => {
+            // `radius0` at the +Y end.
+            let axis = t.rotation * Vec3::Y * (0.5 * length);
+            Outline::TaperedCapsule {
+                a: t.translation + axis,
+                b: t.translation - axis,
+                radius_a: radius0,
+                radius_b: radius1,
             }
         }
         Shape::Box { half_extents } => {

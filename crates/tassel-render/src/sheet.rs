@@ -129,22 +129,15 @@ pub fn draw_view(
                 canvas.circle(cx, cy, radius * s, COLLIDER);
             }
             Outline::Capsule { a, b, radius } => {
-                let (pa, pb) = (pt(a), pt(b));
-                canvas.circle(pa.0, pa.1, radius * s, COLLIDER);
-                canvas.circle(pb.0, pb.1, radius * s, COLLIDER);
-                let d = (pb.0 - pa.0, pb.1 - pa.1);
-                let len = (d.0 * d.0 + d.1 * d.1).sqrt();
-                if len > 1e-3 {
-                    let n = (-d.1 / len * radius * s, d.0 / len * radius * s);
-                    for k in [-1.0, 1.0] {
-                        canvas.line(
-                            (pa.0 + k * n.0, pa.1 + k * n.1),
-                            (pb.0 + k * n.0, pb.1 + k * n.1),
-                            1.2,
-                            COLLIDER,
-                        );
-                    }
-                }
+                capsule(canvas, pt(a), pt(b), radius * s, radius * s);
+            }
+            Outline::TaperedCapsule {
+                a,
+                b,
+                radius_a,
+                radius_b,
+            } => {
+                capsule(canvas, pt(a), pt(b), radius_a * s, radius_b * s);
             }
             Outline::Box { corners } => {
                 for i in 0..8usize {
@@ -199,6 +192,28 @@ pub fn draw_view(
             let (a, e) = (pt(b.from), pt(b.to));
             canvas.line(a, e, width, col);
             canvas.dot(e.0, e.1, width * 0.9, col);
+        }
+    }
+}
+
+/// A capsule's outline between the projected ends `pa` and `pb`: each end's circle (radii
+/// `ra`, `rb` in pixels) and the two lines touching both (straight across for equal radii;
+/// for a taper, the lines through the circles' points normal to the axis, which is what
+/// the rule's radius does along it).
+fn capsule(canvas: &mut Canvas, pa: (f32, f32), pb: (f32, f32), ra: f32, rb: f32) {
+    canvas.circle(pa.0, pa.1, ra, COLLIDER);
+    canvas.circle(pb.0, pb.1, rb, COLLIDER);
+    let d = (pb.0 - pa.0, pb.1 - pa.1);
+    let len = (d.0 * d.0 + d.1 * d.1).sqrt();
+    if len > 1e-3 {
+        let n = (-d.1 / len, d.0 / len);
+        for k in [-1.0, 1.0] {
+            canvas.line(
+                (pa.0 + k * n.0 * ra, pa.1 + k * n.1 * ra),
+                (pb.0 + k * n.0 * rb, pb.1 + k * n.1 * rb),
+                1.2,
+                COLLIDER,
+            );
         }
     }
 }

@@ -3,6 +3,9 @@
 //! plugin's `20221203-v1.10.0` source) with `AdjustBySphereCollision` (outer limits),
 //! `AdjustByCapsuleCollision` and `AdjustByAngleLimit` (`RotateAngleAxis` about the
 //! un-normalised cross product), in 1.10's order: collide, limit, restore the length.
+//! Every case runs twice: with the shoulder capsule, and with it tapered (KawaiiPhysics
+//! master's `AdjustByTaperedCapsuleCollision`, issue 62: `T` from the `Radius0` end, the
+//! radius `Max(Lerp(Radius0, Radius1, T), 0)`, pushed straight from the axis point).
 //!
 //! docs/rig.md lists where `classic` differs from that update on purpose. Each difference
 //! is a switch of the port, written from the docs' description rather than from Tassel's
@@ -58,6 +61,10 @@ const SPHERE_RADIUS: f64 = 0.07;
 const CAPSULE_CENTER: [f64; 3] = [0.0, 1.33, -0.12];
 const CAPSULE_RADIUS: f64 = 0.05;
 const CAPSULE_LENGTH: f64 = 0.3;
+/// The same capsule tapered (KawaiiPhysics master's `FTaperedCapsuleLimit`, issue 62): its
+/// +X end (Tassel's +Y end, `radius0`) wider, its −X end (`radius1`) narrower.
+const TAPER_R0: f64 = 0.07;
+const TAPER_R1: f64 = 0.03;
 
 /// Which of docs/rig.md's deliberate differences the port applies.
 #[derive(Clone, Copy, Debug)]
@@ -91,13 +98,15 @@ macro_rules! kawaii {
             old_gravity: bool,
             limit: bool,
             diffs: Diffs,
+            /// The shoulder capsule is tapered.
+            taper: bool,
             /// Set when a sliding-contact decision came within `KNIFE_EDGE` of its
             /// threshold this frame.
             knife_edge: std::cell::Cell<bool>,
         }
 
         impl $name {
-            fn new(old_gravity: bool, limit: bool, diffs: Diffs) -> Self {
+            fn new(old_gravity: bool, limit: bool, diffs: Diffs, taper: bool) -> Self {
                 let p: Vec<$v> = pose().into_iter().map($to_v).collect();
                 Self {
                     location: p.clone(),
@@ -108,6 +117,7 @@ macro_rules! kawaii {
                     old_gravity,
                     limit,
                     diffs,
+                    taper,
                     knife_edge: std::cell::Cell::new(false),
                 }
             }
@@ -132,6 +142,79 @@ macro_rules! kawaii {
             fn capsule_distance(q: $v) -> $f {
                 let (a, b, _) = Self::capsule();
                 (q - Self::closest_on_segment(q, a, b)).length()
+            }
+
+            /// The shoulder capsule at `q`: its closest axis point and the contact distance
+            /// there. Tapered, KawaiiPhysics master's `AdjustByTaperedCapsuleCollision`:
+            /// `T` from the `Radius0` end along the segment to the other, clamped, and the
+            /// radius `Max(Lerp(Radius0, Radius1, T), 0)`.
+            fn capsule_at(&self, q: $v) -> ($v, $f) {
+                let (a, b, limit) = Self::capsule();
+                if !self.taper {
+                    return (Self::closest_on_segment(q, a, b), limit);
+                }
+                let (start, seg) = (b, a - b);
+                let t = ((q - start).dot(seg) / seg.length_squared()).clamp(0.0, 1.0);
+                let r = (TAPER_R0 as $f + (TAPER_R1 as $f - TAPER_R0 as $f) * t).max(0.0);
+                (start + seg * t, r + POINT_RADIUS as $f)
+            }
+
+            /// How far `q` is inside the shoulder capsule.
+            fn capsule_depth(&self, q: $v) -> $f {
+                let (c, limit) = self.capsule_at(q);
+                limit - (q - c).length()
+            }
+
+            /// docs/rig.md's sliding contact on a tapered capsule: a step whose start is
+            /// not inside (by more than the tolerance, 1e-4 of the contact distance) and
+            /// whose point nearest the axis, or whose end, is inside stops at the first
+            /// crossing of the surface before that point (bisection) and keeps the
+            /// tangential part of the rest; then the rule pushes it out.
+            fn tapered_collide(&self, x: $v, prev: $v) -> $v {
+                let out = |x: $v| {
+                    let (c, limit) = self.capsule_at(x);
+                    if (x - c).length_squared() < limit * limit {
+                        c + (x - c).normalize_or_zero() * limit
+                    } else {
+                        x
+                    }
+                };
+                // Whether `q` is inside beyond the tolerance; `watch`: a knife-edge there is
+                // noted (the start, and the point nearest the axis, as for the capsule).
+                let inside = |q: $v, watch: bool| {
+                    let (c, limit) = self.capsule_at(q);
+                    let margin = limit * 1e-4;
+                    let depth = limit - (q - c).length();
+                    if watch {
+                        self.near_threshold(depth, margin);
+                    }
+                    depth > margin
+                };
+                if self.diffs.slide && !inside(prev, true) && prev != x {
+                    let (a, b, _) = Self::capsule();
+                    let (near, _) = Self::segment_segment(prev, x, a, b);
+                    let hit = [near, 1.0]
+                        .into_iter()
+                        .find(|&w| inside(prev + (x - prev) * w, w < 1.0));
+                    if let Some(hi) = hit {
+                        let (mut lo, mut hi) = (0.0 as $f, hi);
+                        for _ in 0..100 {
+                            let mid = 0.5 * (lo + hi);
+                            if self.capsule_depth(prev + (x - prev) * mid)
+                                > self.capsule_at(prev + (x - prev) * mid).1 * 1e-4
+                            {
+                                hi = mid;
+                            } else {
+                                lo = mid;
+                            }
+                        }
+                        let contact = prev + (x - prev) * lo;
+                        let n = (contact - self.capsule_at(contact).0).normalize();
+                        let rest = x - contact;
+                        return out(contact + rest - n * rest.dot(n).min(0.0));
+                    }
+                }
+                out(x)
             }
 
             /// Closest approach of segment p0–p1 to segment a–b: (s on p0–p1, distance).
@@ -259,6 +342,9 @@ macro_rules! kawaii {
 
             fn collide(&self, x: $v, prev: $v) -> $v {
                 let x = self.sphere(x, prev);
+                if self.taper {
+                    return self.tapered_collide(x, prev);
+                }
                 self.capsule_collide(x, prev)
             }
 
@@ -398,8 +484,7 @@ macro_rules! kawaii {
             fn collide_static(&self, x: $v) -> $v {
                 let c = Self::v(SPHERE_CENTER);
                 let x = Self::out_of_sphere(x, c, (SPHERE_RADIUS + POINT_RADIUS) as $f);
-                let (a, b, limit) = Self::capsule();
-                let q = Self::closest_on_segment(x, a, b);
+                let (q, limit) = self.capsule_at(x);
                 if (x - q).length_squared() < limit * limit {
                     q + (x - q).normalize() * limit
                 } else {
@@ -428,7 +513,7 @@ kawaii!(
     |q: DQuat| q.as_quat()
 );
 
-fn rig(gravity: ClassicGravity, limit: bool) -> RigSettings {
+fn rig(gravity: ClassicGravity, limit: bool, taper: bool) -> RigSettings {
     let root = pose()[0];
     let offset = |c: [f64; 3]| (DVec3::from(c) - root).as_vec3();
     RigSettings {
@@ -472,9 +557,17 @@ fn rig(gravity: ClassicGravity, limit: bool) -> RigSettings {
                 offset: offset(CAPSULE_CENTER),
                 // Tassel's capsules lie along local +Y: turn +Y onto +X.
                 rotation: Quat::from_rotation_z(-std::f32::consts::FRAC_PI_2),
-                shape: Shape::Capsule {
-                    radius: CAPSULE_RADIUS as f32,
-                    length: CAPSULE_LENGTH as f32,
+                shape: if taper {
+                    Shape::TaperedCapsule {
+                        radius0: TAPER_R0 as f32,
+                        radius1: TAPER_R1 as f32,
+                        length: CAPSULE_LENGTH as f32,
+                    }
+                } else {
+                    Shape::Capsule {
+                        radius: CAPSULE_RADIUS as f32,
+                        length: CAPSULE_LENGTH as f32,
+                    }
                 },
             },
         ],
@@ -496,16 +589,25 @@ struct Case {
 }
 
 /// Runs one case: Tassel, and the port with `diffs` in f64 and in f32.
-fn run(gravity: ClassicGravity, limit: bool, motion: &str, hz: f64, diffs: Diffs) -> Case {
+fn run(
+    gravity: ClassicGravity,
+    limit: bool,
+    motion: &str,
+    hz: f64,
+    diffs: Diffs,
+    taper: bool,
+) -> Case {
     let old = gravity == ClassicGravity::PerFrame;
     let sk = skeleton();
-    let mut sim = CharacterSim::new(sk.clone(), &rig(gravity, limit)).unwrap();
-    let mut kp = Kawaii::new(old, limit, diffs);
-    let mut kp32 = Kawaii32::new(old, limit, diffs);
+    let mut sim = CharacterSim::new(sk.clone(), &rig(gravity, limit, taper)).unwrap();
+    let mut kp = Kawaii::new(old, limit, diffs, taper);
+    let mut kp32 = Kawaii32::new(old, limit, diffs, taper);
     // The same f64 port with the character's position off by ±6e-8 m (half an f32 ulp at
     // 1 m) along X, Y or Z, alternating per frame in two phases: how far rounding-sized
     // noise alone moves this case.
-    let mut kp_noisy: Vec<Kawaii> = (0..6).map(|_| Kawaii::new(old, limit, diffs)).collect();
+    let mut kp_noisy: Vec<Kawaii> = (0..6)
+        .map(|_| Kawaii::new(old, limit, diffs, taper))
+        .collect();
     let rest = sk.rest().to_vec();
     sim.frame(&rest, Transform::IDENTITY, 0.0).unwrap();
     let (mut worst, mut rounding, mut contact_frames, mut compared) = (0.0f64, 0.0f64, 0, 0);
@@ -535,7 +637,7 @@ fn run(gravity: ClassicGravity, limit: bool, motion: &str, hz: f64, diffs: Diffs
                 rounding = rounding.max((noisy.joint(j) - kp.joint(j)).length());
             }
             touching |= (kp.joint(j) - c).length() < SPHERE_RADIUS + POINT_RADIUS + 1e-6
-                || Kawaii::capsule_distance(kp.joint(j)) < CAPSULE_RADIUS + POINT_RADIUS + 1e-6;
+                || kp.capsule_depth(kp.joint(j)) > -1e-6;
         }
         contact_frames += touching as usize;
     }
@@ -550,12 +652,17 @@ fn run(gravity: ClassicGravity, limit: bool, motion: &str, hz: f64, diffs: Diffs
 #[test]
 fn classic_with_contacts_differs_from_kawaiiphysics_1_10_only_as_documented() {
     let (mut worst_all, mut frames, mut compared, mut contacts) = (0.0f64, 0, 0, 0);
-    for gravity in [ClassicGravity::PerFrame, ClassicGravity::HalfDtSquared] {
+    for (gravity, taper) in [
+        (ClassicGravity::PerFrame, false),
+        (ClassicGravity::HalfDtSquared, false),
+        (ClassicGravity::PerFrame, true),
+        (ClassicGravity::HalfDtSquared, true),
+    ] {
         for limit in [false, true] {
             for motion in ["still", "sway", "step", "turn"] {
                 for hz in [30.0f64, 60.0, 144.0] {
-                    let case = run(gravity, limit, motion, hz, TASSEL);
-                    let plain = run(gravity, limit, motion, hz, KAWAII).worst;
+                    let case = run(gravity, limit, motion, hz, TASSEL, taper);
+                    let plain = run(gravity, limit, motion, hz, KAWAII, taper).worst;
                     let left_out: Vec<String> = [
                         (
                             "order",
@@ -580,10 +687,16 @@ fn classic_with_contacts_differs_from_kawaiiphysics_1_10_only_as_documented() {
                         ),
                     ]
                     .iter()
-                    .map(|(n, d)| format!("{n} {:.1e}", run(gravity, limit, motion, hz, *d).worst))
+                    .map(|(n, d)| {
+                        format!(
+                            "{n} {:.1e}",
+                            run(gravity, limit, motion, hz, *d, taper).worst
+                        )
+                    })
                     .collect();
+                    let shoulders = if taper { "tapered" } else { "capsule" };
                     println!(
-                        "{gravity:?} limit {limit} {motion} {hz} Hz: {} of 120 frames compared \
+                        "{gravity:?} {shoulders} limit {limit} {motion} {hz} Hz: {} of 120 frames compared \
                          ({} with a contact); Tassel vs the port with the documented \
                          differences {:.2e} m (rounding alone {:.1e}); vs plain KawaiiPhysics \
                          1.10 {plain:.2e} m; with one difference left out: {}",
@@ -595,7 +708,7 @@ fn classic_with_contacts_differs_from_kawaiiphysics_1_10_only_as_documented() {
                     );
                     assert!(
                         case.worst <= 2e-5_f64.max(2.0 * case.rounding),
-                        "{gravity:?} limit {limit} {motion} {hz} Hz: {} m (rounding alone: {} m)",
+                        "{gravity:?} {shoulders} limit {limit} {motion} {hz} Hz: {} m (rounding alone: {} m)",
                         case.worst,
                         case.rounding
                     );

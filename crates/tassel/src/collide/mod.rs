@@ -9,11 +9,13 @@ pub(crate) mod entry_lanes;
 pub(crate) mod lanes;
 mod plane;
 mod sphere;
+mod tapered;
 
 pub use capsule::{capsule_penetration, push_out_of_capsule};
 pub use plane::{plane_penetration, push_above_plane};
 pub use r#box::{box_penetration, push_out_of_box};
 pub use sphere::{push_into_sphere, push_out_of_sphere, sphere_penetration};
+pub use tapered::{push_out_of_tapered_capsule, tapered_capsule_penetration, Tapered};
 
 use crate::math::Transform;
 use glam::{Vec3, Vec4};
@@ -36,6 +38,17 @@ pub enum Shape {
         /// Radius in metres (≥ 0).
         radius: f32,
         /// Length of the axis segment between the two cap centres, metres (≥ 0).
+        length: f32,
+    },
+    /// A capsule along local +Y, centred on the origin, whose radius changes linearly from
+    /// `radius0` at its +Y end to `radius1` at its −Y end (KawaiiPhysics' tapered capsule,
+    /// and its push-out rule: see [`push_out_of_tapered_capsule`]).
+    TaperedCapsule {
+        /// Radius at the +Y end, metres (≥ 0).
+        radius0: f32,
+        /// Radius at the −Y end, metres (≥ 0).
+        radius1: f32,
+        /// Distance between the two ends' centres, metres (≥ 0).
         length: f32,
     },
     /// An oriented box centred on the origin.
@@ -63,6 +76,19 @@ impl Shape {
             {
                 bad(format!(
                     "{what}: capsule radius {radius} and length {length} must be finite and ≥ 0"
+                ))
+            }
+            Shape::TaperedCapsule {
+                radius0,
+                radius1,
+                length,
+            } if ![radius0, radius1, length]
+                .iter()
+                .all(|v| v.is_finite() && *v >= 0.0) =>
+            {
+                bad(format!(
+                    "{what}: tapered capsule radius0 {radius0}, radius1 {radius1} and length \
+                     {length} must be finite and ≥ 0"
                 ))
             }
             Shape::Box { half_extents }
@@ -190,6 +216,14 @@ impl PlacedCollider {
                 let (a, b) = self.capsule_ends(length);
                 push_out_of_capsule(p, prev, a, b, radius + r)
             }
+            Shape::TaperedCapsule {
+                radius0,
+                radius1,
+                length,
+            } => {
+                let tapered = self.tapered_of(radius0, radius1, length, r);
+                push_out_of_tapered_capsule(p, prev, &tapered, t.rotation * Vec3::X)
+            }
             Shape::Box { half_extents } => push_out_of_box(p, t, half_extents, r),
             Shape::Plane => push_above_plane(p, prev, t.translation, t.rotation * Vec3::Y, r),
         }
@@ -220,6 +254,11 @@ impl PlacedCollider {
                 let (a, b) = self.capsule_ends(length);
                 capsule_penetration(p, a, b, radius + r)
             }
+            Shape::TaperedCapsule {
+                radius0,
+                radius1,
+                length,
+            } => tapered_capsule_penetration(p, &self.tapered_of(radius0, radius1, length, r)),
             Shape::Box { half_extents } => box_penetration(p, t, half_extents, r),
             Shape::Plane => plane_penetration(p, t.translation, t.rotation * Vec3::Y, r),
         }
@@ -259,8 +298,38 @@ impl PlacedCollider {
                 inside: false,
             } => Some(radius),
             Shape::Capsule { radius, length } => Some(radius + 0.5 * length),
+            Shape::TaperedCapsule {
+                radius0,
+                radius1,
+                length,
+            } => Some(radius0.max(radius1) + 0.5 * length),
             Shape::Box { half_extents } => Some(half_extents.length()),
             _ => None,
+        }
+    }
+
+    /// A tapered capsule placed, for a point of radius `r`: its +Y end (`radius0`) first.
+    /// `None` for other shapes.
+    pub fn tapered(&self, r: f32) -> Option<Tapered> {
+        let Shape::TaperedCapsule {
+            radius0,
+            radius1,
+            length,
+        } = self.shape
+        else {
+            return None;
+        };
+        Some(self.tapered_of(radius0, radius1, length, r))
+    }
+
+    fn tapered_of(&self, radius0: f32, radius1: f32, length: f32, r: f32) -> Tapered {
+        let (b, a) = self.capsule_ends(length);
+        Tapered {
+            a,
+            b,
+            radius0,
+            radius1,
+            point: r,
         }
     }
 

@@ -209,14 +209,21 @@ pub fn chain_feature(ch: &mut tassel::dynamics::chain::ChainSettings, feature: u
 }
 
 /// Every collider shape in a bench rig (`builtin::bench_character` with at least four
-/// colliders: spheres and capsules): collider 1 becomes a box, collider 3 a turned
-/// capsule, and a tilted floor plane and a keep-inside sphere join them.
+/// colliders: spheres and capsules): collider 1 becomes a box, collider 2 a tilted tapered
+/// capsule, collider 3 a turned capsule, and a tilted floor plane and a keep-inside sphere
+/// join them.
 pub fn every_collider_shape(rig: &mut tassel::dynamics::RigSettings) {
     use tassel::collide::Shape;
     use tassel::dynamics::ColliderSettings;
     rig.colliders[1].shape = Shape::Box {
         half_extents: Vec3::new(0.05, 0.08, 0.03),
     };
+    rig.colliders[2].shape = Shape::TaperedCapsule {
+        radius0: 0.08,
+        radius1: 0.02,
+        length: 0.2,
+    };
+    rig.colliders[2].rotation = Quat::from_rotation_x(0.5);
     rig.colliders[3].rotation = Quat::from_rotation_z(0.6);
     rig.colliders.push(ColliderSettings {
         mirror: None,
