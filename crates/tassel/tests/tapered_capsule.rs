@@ -89,8 +89,8 @@ fn chains_never_end_a_frame_inside_a_fast_tapered_capsule() {
 }
 
 /// The built-in character with its leg capsules tapered (each 1.3× as wide at its +Y
-/// end, 0.8× at its −Y end) through the demo: the skirt's cloth points, and its bones,
-/// stay out of them at every rate.
+/// end, 0.8× at its −Y end) through the demo: the skirt's cloth points, and the charm's
+/// rope points (which collide with the left thigh), stay out of them at every rate.
 #[test]
 fn the_skirt_stays_out_of_tapered_legs_at_every_rate() {
     let mut c = builtin::character();
@@ -125,6 +125,14 @@ fn the_skirt_stays_out_of_tapered_legs_at_every_rate() {
         let dt = 1.0 / hz;
         let frames = (DemoScript::DURATION * hz).round() as usize;
         let (mut worst, mut near) = (f32::MIN, 0usize);
+        let (mut worst_rope, mut near_rope) = (f32::MIN, 0usize);
+        let thigh = c
+            .rig
+            .colliders
+            .iter()
+            .position(|col| col.name == "thigh_l")
+            .unwrap();
+        assert!(c.rig.ropes[0].colliders.contains(&"thigh_l".to_string()));
         for f in 0..=frames {
             let m = script.at(f as f32 * dt);
             let step = if f == 0 { 0.0 } else { dt };
@@ -143,7 +151,24 @@ fn the_skirt_stays_out_of_tapered_legs_at_every_rate() {
                     near += usize::from(d > -0.03);
                 }
             }
+            for &p in &sim.ropes().output_positions(0)[1..] {
+                assert!(p.is_finite());
+                let d = placed[thigh].penetration(p, 0.0);
+                worst_rope = worst_rope.max(d);
+                near_rope += usize::from(d > -0.03);
+            }
         }
+        println!(
+            "{hz} Hz: worst rope point {worst_rope:.5} m into the tapered thigh; {near_rope} near"
+        );
+        assert!(
+            near_rope > 0,
+            "{hz} Hz: the charm never came near the thigh"
+        );
+        assert!(
+            worst_rope <= 1e-3,
+            "{hz} Hz: a rope point ended {worst_rope} m inside the tapered thigh"
+        );
         println!("{hz} Hz: worst cloth point {worst:.5} m into a tapered leg; {near} near");
         assert!(near > 0, "{hz} Hz: the legs never came near the skirt");
         assert!(
