@@ -180,15 +180,21 @@ class BoneParts {
    *  and (with `world`) its `matrixWorld` from its parent's, as three-vrm leaves its spring
    *  bones. The quaternion is written through its fields: three.js's setter would also
    *  recompute the Euler `rotation`, which costs more than the whole spring step;
-   *  `syncRotation` asks for it. */
-  write(k, v, at, syncRotation, world) {
+   *  `syncRotation` asks for it. With `turnOnly` the position and scale objects are left
+   *  alone: a crowd only turns the bones it writes, so they already hold the values in
+   *  `v` (this frame's animated ones, read from them or unchanged since); each is a heap
+   *  object of its own, and touching it was a fifth of the crowd's transfer. */
+  write(k, v, at, syncRotation, world, turnOnly = false) {
     const tx = v[at], ty = v[at + 1], tz = v[at + 2];
     const x = v[at + 3], y = v[at + 4], z = v[at + 5], w = v[at + 6];
     const sx = v[at + 7], sy = v[at + 8], sz = v[at + 9];
-    const p = this.p[k], q = this.q[k], s = this.s[k];
-    p.x = tx; p.y = ty; p.z = tz;
+    const q = this.q[k];
+    if (!turnOnly) {
+      const p = this.p[k], s = this.s[k];
+      p.x = tx; p.y = ty; p.z = tz;
+      s.x = sx; s.y = sy; s.z = sz;
+    }
     q._x = x; q._y = y; q._z = z; q._w = w;
-    s.x = sx; s.y = sy; s.z = sz;
     if (syncRotation) this.object[k].rotation.setFromQuaternion(q, undefined, false);
     // As Matrix4.compose.
     const m = this.m[k];
@@ -298,17 +304,17 @@ function writePlan(parts, order, scene, world) {
 }
 
 /** Writes a character's bones by its plan (see writePlan): joint k from `v[base + at(k)..]`. */
-function writeBones(parts, { plan, refresh }, v, base, at, syncRotation, world) {
+function writeBones(parts, { plan, refresh }, v, base, at, syncRotation, world, turnOnly = false) {
   for (let i = 0; i < plan.length; i++) {
     const e = plan[i];
-    if (e >= 0) parts.write(e, v, base + at[e], syncRotation, world);
+    if (e >= 0) parts.write(e, v, base + at[e], syncRotation, world, turnOnly);
     else refresh[-1 - e].updateWorldMatrix(false, false);
   }
 }
 
 /** One character stepped by Tassel: what both public classes drive. */
 class Driver {
-  constructor(tassel, ptr, gltf, options) {
+  constructor(tassel, ptr, gltf, options, turnOnly = false) {
     const x = tassel.x;
     this.tassel = tassel;
     this.ptr = ptr;
@@ -316,6 +322,9 @@ class Driver {
     this.onError = options.onError ?? null;
     this.syncRotation = options.syncRotation ?? false;
     this.worldMatrices = options.worldMatrices ?? true;
+    // VRM spring bones alone only turn the bones they write (a rig file's solvers are not
+    // assumed to): their position and scale objects are then left alone.
+    this.turnOnly = turnOnly;
     this.lastError = null;
     this.mode = tassel.string(x.tassel_mode(ptr));
     const { n, depths } = jointTable(tassel, ptr);
@@ -428,11 +437,9 @@ class Driver {
     this.lastError = null;
     const out = this.locals();
     const writtenAt = this.writtenAt;
-    for (let k = 0; k < writtenAt.length; k++) {
-      const at = writtenAt[k];
-      for (let i = 0; i < FLOATS; i++) wrote[at + i] = out[at + i];
-    }
-    writeBones(this.out, this.plan, out, 0, writtenAt, this.syncRotation, this.worldMatrices);
+    // Every joint's (only the written ones' are ever compared): one copy.
+    wrote.set(out);
+    writeBones(this.out, this.plan, out, 0, writtenAt, this.syncRotation, this.worldMatrices, this.turnOnly);
     this.hasWritten = true;
     return true;
   }
@@ -532,7 +539,7 @@ export class TasselSpringBoneManager extends Stepped {
   static async fromGLTF(gltf, bytes, options = {}) {
     const tassel = await loadTassel(options.wasm);
     const ptr = tassel.load(bytes, options.rigToml ?? null, options.mode ?? 'fixed');
-    return new TasselSpringBoneManager(new Driver(tassel, ptr, gltf, options));
+    return new TasselSpringBoneManager(new Driver(tassel, ptr, gltf, options, options.rigToml == null));
   }
 }
 
@@ -710,10 +717,10 @@ export class TasselCrowd {
       const member = members[m];
       if (held[m] === 1) continue;
       member.lastError = null;
-      const wrote = member._wrote;
       const base = m * W;
-      for (let i = 0; i < W; i++) wrote[i] = out[base + i];
-      writeBones(member._out, member._plan, out, base, writtenAt, syncRotation, world);
+      member._wrote.set(out.subarray(base, base + W));
+      // The crowd's kinds (VRM springs, chains) turn joints only.
+      writeBones(member._out, member._plan, out, base, writtenAt, syncRotation, world, true);
       member._hasWritten = true;
     }
     return code === 0;
