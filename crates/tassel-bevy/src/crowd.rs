@@ -337,9 +337,9 @@ impl Kind {
         }
     }
 
-    /// The tagged write pass's view of this kind: its members' output rotations gathered
-    /// (when a member is tagged).
-    pub(crate) fn write_view(&mut self) -> WriteView<'_> {
+    /// Gathers the members' output rotations for the tagged write pass (when a member is
+    /// tagged).
+    pub(crate) fn gather_rotations(&mut self) {
         let tagged = self.access.contains(&Access::Tags);
         self.rotations.resize(
             if tagged {
@@ -356,6 +356,10 @@ impl Kind {
                 Run::Chains(c) => c.rotations(&mut self.rotations),
             };
         }
+    }
+
+    /// The tagged write pass's view of this kind (after [`Kind::gather_rotations`]).
+    pub(crate) fn write_view(&self) -> WriteView<'_> {
         WriteView {
             kind: key(&self.rig),
             member_of: &self.member_of,
@@ -572,6 +576,54 @@ pub(crate) fn key(rig: &Arc<CharacterRig>) -> usize {
 }
 
 impl Crowds {
+    /// Reads every tagged bone whose `Transform` changed since the step system last ran
+    /// into its member's input (bones come kind after kind in table order: the view of the
+    /// last kind met is kept, and looked up again only when the kind changes).
+    pub(crate) fn read_tagged(
+        &mut self,
+        bones: &Query<(&CrowdBone, &BevyTransform), Changed<BevyTransform>>,
+    ) {
+        if self.kinds.is_empty() {
+            return;
+        }
+        let mut view: Option<ReadView> = None;
+        for (bone, t) in bones {
+            if view.as_ref().map(|v| v.kind) != Some(bone.kind) {
+                view = self.kinds.get_mut(&bone.kind).map(Kind::read_view);
+            }
+            if let Some(v) = view.as_mut() {
+                v.take(bone, t);
+            }
+        }
+    }
+
+    /// Writes every tagged, written bone of a member that stepped, from its kind's output
+    /// rotations, in the compute pool's threads (each thread keeps the view of the last
+    /// kind it met).
+    pub(crate) fn write_tagged(
+        &mut self,
+        bones: &mut Query<(&CrowdBone, &mut BevyTransform), With<WrittenBone>>,
+    ) {
+        if self.kinds.is_empty() {
+            return;
+        }
+        for kind in self.kinds.values_mut() {
+            kind.gather_rotations();
+        }
+        let kinds = &self.kinds;
+        bones.par_iter_mut().for_each_init(
+            || None::<WriteView>,
+            |view, (bone, mut t)| {
+                if view.as_ref().map(|v| v.kind) != Some(bone.kind) {
+                    *view = kinds.get(&bone.kind).map(Kind::write_view);
+                }
+                if let Some(r) = view.as_ref().and_then(|v| v.rotation(bone)) {
+                    t.rotation = r;
+                }
+            },
+        );
+    }
+
     /// Adds `entity` (a character of kind `rig`) to its kind's crowd when the kind runs as
     /// one; returns its index, or `None` (the character steps on its own).
     pub(crate) fn join(

@@ -78,66 +78,38 @@ pub(crate) struct WriteView<'k> {
     pub(crate) rotations: &'k [Quat],
 }
 
-/// Reads every tagged bone that changed since the step system last ran into its member's
-/// `locals`.
-pub(crate) fn read_tagged(
-    views: &mut [ReadView<'_>],
-    bones: &Query<(&CrowdBone, &BevyTransform), Changed<BevyTransform>>,
-) {
-    if views.is_empty() {
-        return;
-    }
-    let mut at = 0;
-    for (bone, t) in bones {
-        if !bone.reads {
-            continue;
-        }
-        if views[at].kind != bone.kind {
-            match views.iter().position(|v| v.kind == bone.kind) {
-                Some(i) => at = i,
-                None => continue,
-            }
-        }
-        let v = &mut views[at];
-        let Some(&m) = v.member_of.get(bone.uid as usize) else {
-            continue;
+impl ReadView<'_> {
+    /// Takes the animated transform `t` of tagged bone `bone` (of this view's kind) into its
+    /// member's `locals`, when the member reads through its tags.
+    #[inline]
+    pub(crate) fn take(&mut self, bone: &CrowdBone, t: &BevyTransform) {
+        let Some(&m) = self.member_of.get(bone.uid as usize) else {
+            return;
         };
         let m = m as usize;
-        if v.access.get(m) != Some(&Access::Tags) {
-            continue;
+        if bone.reads && self.access.get(m) == Some(&Access::Tags) {
+            self.locals[m * self.joints + bone.joint as usize] = to_tassel(t);
         }
-        v.locals[m * v.joints + bone.joint as usize] = to_tassel(t);
     }
 }
 
-/// Writes every tagged, written bone of a member that stepped (not held) from its
-/// kind's output, in the compute pool's threads. Only the rotation: a crowd turns the
-/// bones it writes, and their translation and scale are already this frame's animated
-/// ones (read from them, or unchanged since they were), which is what the per-entity
-/// path writes back with the rotation.
-pub(crate) fn write_tagged(
-    views: &[WriteView<'_>],
-    bones: &mut Query<(&CrowdBone, &mut BevyTransform), With<WrittenBone>>,
-) {
-    if views.is_empty() {
-        return;
-    }
-    bones.par_iter_mut().for_each(|(bone, mut t)| {
+impl WriteView<'_> {
+    /// The rotation tagged, written bone `bone` (of this view's kind) gets: its member's
+    /// output, when the member writes through its tags and stepped (was not held). Only
+    /// the rotation: a crowd turns the bones it writes, and their translation and scale
+    /// are already this frame's animated ones (read from them, or unchanged since), which
+    /// is what the per-entity path writes back with the rotation.
+    #[inline]
+    pub(crate) fn rotation(&self, bone: &CrowdBone) -> Option<Quat> {
         if bone.slot == NOT_WRITTEN {
-            return;
+            return None;
         }
-        let Some(v) = views.iter().find(|v| v.kind == bone.kind) else {
-            return;
-        };
-        let Some(&m) = v.member_of.get(bone.uid as usize) else {
-            return;
-        };
-        let m = m as usize;
-        if v.access.get(m) != Some(&Access::Tags) || v.held[m] {
-            return;
+        let m = *self.member_of.get(bone.uid as usize)? as usize;
+        if self.access.get(m) != Some(&Access::Tags) || self.held[m] {
+            return None;
         }
-        if let Some(&r) = v.rotations.get(m * v.slots + bone.slot as usize) {
-            t.rotation = r;
-        }
-    });
+        self.rotations
+            .get(m * self.slots + bone.slot as usize)
+            .copied()
+    }
 }

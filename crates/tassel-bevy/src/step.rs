@@ -13,7 +13,7 @@
 use crate::character::TasselCharacter;
 use crate::convert::{to_bevy, to_tassel, world_of};
 use crate::crowd::Crowds;
-use crate::crowd_bones::{read_tagged, write_tagged, CrowdBone, ReadView, WriteView, WrittenBone};
+use crate::crowd_bones::{CrowdBone, WrittenBone};
 use crate::TasselError;
 use bevy::diagnostic::{Diagnostic, DiagnosticPath, Diagnostics};
 use bevy::ecs::prelude::*;
@@ -181,10 +181,7 @@ pub(crate) fn step_characters(
             kind.read(&transforms, &parents);
         }
     }
-    {
-        let mut views: Vec<ReadView> = crowds.kinds.values_mut().map(|k| k.read_view()).collect();
-        read_tagged(&mut views, &transforms.p1());
-    }
+    crowds.read_tagged(&transforms.p1());
     let read = Instant::now();
     // Step: the characters on their own sims in parallel, then each crowd (its lane
     // groups in parallel), all on Bevy's compute task pool.
@@ -221,10 +218,7 @@ pub(crate) fn step_characters(
     for kind in crowds.kinds.values_mut() {
         kind.write(&mut transforms.p0());
     }
-    {
-        let views: Vec<WriteView> = crowds.kinds.values_mut().map(|k| k.write_view()).collect();
-        write_tagged(&views, &mut transforms.p2());
-    }
+    crowds.write_tagged(&mut transforms.p2());
     for kind in crowds.kinds.values_mut() {
         kind.tags_arrived();
     }
