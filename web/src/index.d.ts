@@ -7,10 +7,10 @@ export interface GLTFLike {
   parser: { associations: Map<unknown, { nodes?: number }> };
 }
 
-export type TasselMode = 'fixed' | 'spec' | 'three-vrm' | 'classic' | 'kawaii';
+export type TasselMode = 'fixed' | 'spec' | 'three-vrm' | 'classic' | 'kawaii' | 'spcr';
 
 export interface TasselOptions {
-  /** fixed (default), spec, three-vrm, classic or kawaii. */
+  /** fixed (default), spec, three-vrm, classic, kawaii or spcr. */
   mode?: TasselMode;
   /** Where the .wasm is (URL), its bytes, or a compiled module; default: beside index.js. */
   wasm?: string | URL | ArrayBuffer | Uint8Array | WebAssembly.Module;

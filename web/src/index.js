@@ -501,7 +501,7 @@ class Stepped {
     this._driver = driver;
   }
 
-  /** `fixed`, `spec`, `three-vrm`, `classic` or `kawaii`. */
+  /** `fixed`, `spec`, `three-vrm`, `classic`, `kawaii` or `spcr`. */
   get mode() { return this._driver.mode; }
   /** The three.js objects Tassel writes (the simulated bones). */
   get bones() { return Array.from(this._driver.written, (j) => this._driver.objects[j]); }
@@ -780,7 +780,7 @@ export class TasselCrowdMember {
     this._capture();
   }
 
-  /** `fixed`, `spec`, `three-vrm`, `classic` or `kawaii`. */
+  /** `fixed`, `spec`, `three-vrm`, `classic`, `kawaii` or `spcr`. */
   get mode() { return this._crowd?.mode ?? null; }
   /** The three.js objects Tassel writes (the simulated bones). */
   get bones() { return this._out.object.filter((o) => o !== null && o !== undefined); }

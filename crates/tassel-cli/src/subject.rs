@@ -18,6 +18,8 @@ pub enum Mode {
     ThreeVrm,
     /// Chains as KawaiiPhysics 1.21 steps them by default (fixed substepping).
     Kawaii,
+    /// Bone cloths as SPCRJointDynamicsUE4 runs them.
+    Spcr,
 }
 
 impl From<Mode> for SimMode {
@@ -28,6 +30,7 @@ impl From<Mode> for SimMode {
             Mode::Classic => SimMode::Classic,
             Mode::ThreeVrm => SimMode::ThreeVrm,
             Mode::Kawaii => SimMode::Kawaii,
+            Mode::Spcr => SimMode::Spcr,
         }
     }
 }

@@ -33,9 +33,9 @@ extern "C" {
 // are external files is an error naming the URI; data: URIs work; see
 // `tassel_character_load_file`). `rig_toml` (may be NULL) is a rig file's text: chains,
 // springs, cloths, ropes; without it the file's VRM spring bones run (a file without
-// them is an error). `mode` (may be NULL) is "fixed", "spec", "three-vrm", "classic" or
-// "kawaii"; NULL as `tassel simulate` without `--mode`: "fixed", unless the rig sets its
-// chains to "classic" or "kawaii".
+// them is an error). `mode` (may be NULL) is "fixed", "spec", "three-vrm", "classic",
+// "kawaii" or "spcr"; NULL as `tassel simulate` without `--mode`: "fixed", unless the rig
+// sets its chains to "classic" or "kawaii" (or, without chains, its first cloth to "spcr").
 //
 // The character is left as `tassel simulate` has it before its frame 1 (a zero-length
 // frame at the rest pose, at the origin). NULL on error: `tassel_last_error()` says why.
@@ -197,7 +197,8 @@ int32_t tassel_read_joints(const TasselCharacter *c,
                            size_t *out,
                            size_t len);
 
-// The mode the character steps in ("fixed", "spec", "three-vrm", "classic" or "kawaii"),
+// The mode the character steps in ("fixed", "spec", "three-vrm", "classic", "kawaii" or
+// "spcr"),
 // borrowed: valid while the character lives. NULL for NULL.
 //
 // # Safety

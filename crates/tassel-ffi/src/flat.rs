@@ -135,7 +135,7 @@ fn springs_from_json(
     Ok(info.map(|i| i.springs).unwrap_or_default())
 }
 
-/// `"fixed"`, `"spec"`, `"three-vrm"`, `"classic"` or `"kawaii"` (as `tassel simulate
+/// `"fixed"`, `"spec"`, `"three-vrm"`, `"classic"`, `"kawaii"` or `"spcr"` (as `tassel simulate
 /// --mode`).
 pub fn parse_mode(name: &str) -> Result<SimMode, String> {
     [
@@ -144,11 +144,12 @@ pub fn parse_mode(name: &str) -> Result<SimMode, String> {
         SimMode::ThreeVrm,
         SimMode::Classic,
         SimMode::Kawaii,
+        SimMode::Spcr,
     ]
     .into_iter()
     .find(|m| m.name() == name)
     .ok_or_else(|| {
-        format!("mode '{name}' is not one of fixed, spec, three-vrm, classic, kawaii (as tassel simulate --mode)")
+        format!("mode '{name}' is not one of fixed, spec, three-vrm, classic, kawaii, spcr (as tassel simulate --mode)")
     })
 }
 

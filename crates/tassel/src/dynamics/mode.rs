@@ -2,6 +2,7 @@
 //! `bake`, `render` and `plot`.
 
 use super::chain::TimeMode;
+use super::cloth::ClothMode;
 use super::vrm::{VrmMode, VrmOptions};
 use super::RigSettings;
 use crate::error::{Error, Result};
@@ -26,10 +27,14 @@ pub enum SimMode {
     /// [`TimeMode::Kawaii`]), VRM springs by the specification: for a user moving from
     /// KawaiiPhysics 1.21.
     Kawaii,
+    /// Bone cloths as SPCRJointDynamicsUE4 runs them ([`ClothMode::Spcr`]), for a user
+    /// bringing an SPCR setup; chains keep the mode the rig file gives them, VRM springs
+    /// step as in `fixed`.
+    Spcr,
 }
 
 impl SimMode {
-    /// `spec`, `fixed`, `classic`, `three-vrm` or `kawaii`.
+    /// `spec`, `fixed`, `classic`, `three-vrm`, `kawaii` or `spcr`.
     pub fn name(self) -> &'static str {
         match self {
             SimMode::Spec => "spec",
@@ -37,14 +42,16 @@ impl SimMode {
             SimMode::Classic => "classic",
             SimMode::ThreeVrm => "three-vrm",
             SimMode::Kawaii => "kawaii",
+            SimMode::Spcr => "spcr",
         }
     }
 
     /// Settles the mode for a rig (and a model with or without VRM springs) and sets the
     /// rig's chains to it. Without a requested mode: `fixed` for a model with VRM springs,
     /// else the first chain's own mode (the rig file's choice; `fixed` unless it says
-    /// `classic` or `kawaii`). `spec` without VRM springs is an error; `fixed`, `classic`
-    /// or `kawaii` asked for explicitly set every chain's mode.
+    /// `classic` or `kawaii`; `spcr` when there are no chains and the first cloth says
+    /// `spcr`). `spec` without VRM springs is an error; `fixed`, `classic` or `kawaii`
+    /// asked for explicitly set every chain's mode; `fixed` and `spcr` set every cloth's.
     pub fn apply(
         requested: Option<SimMode>,
         rig: &mut RigSettings,
@@ -56,6 +63,9 @@ impl SimMode {
             None => match rig.chains.first().map(|c| c.mode) {
                 Some(TimeMode::Classic) => SimMode::Classic,
                 Some(TimeMode::Kawaii) => SimMode::Kawaii,
+                None if rig.cloths.first().map(|c| c.mode) == Some(ClothMode::Spcr) => {
+                    SimMode::Spcr
+                }
                 _ => SimMode::Fixed,
             },
         };
@@ -70,15 +80,23 @@ impl SimMode {
                 SimMode::Classic => Some(TimeMode::Classic),
                 SimMode::Fixed => Some(TimeMode::Fixed),
                 SimMode::Kawaii => Some(TimeMode::Kawaii),
-                SimMode::Spec | SimMode::ThreeVrm => None,
+                SimMode::Spec | SimMode::ThreeVrm | SimMode::Spcr => None,
             };
             for c in &mut rig.chains {
                 c.mode = chains.unwrap_or(c.mode);
             }
+            let cloths = match mode {
+                SimMode::Fixed => Some(ClothMode::Fixed),
+                SimMode::Spcr => Some(ClothMode::Spcr),
+                _ => None,
+            };
+            for c in &mut rig.cloths {
+                c.mode = cloths.unwrap_or(c.mode);
+            }
         }
         let options = rig.vrm.apply(VrmOptions {
             mode: match mode {
-                SimMode::Fixed => VrmMode::Fixed,
+                SimMode::Fixed | SimMode::Spcr => VrmMode::Fixed,
                 SimMode::ThreeVrm => VrmMode::ThreeVrm,
                 SimMode::Spec | SimMode::Classic | SimMode::Kawaii => VrmMode::Spec,
             },

@@ -247,9 +247,37 @@ impl Default for RigSettings {
 impl RigSettings {
     /// Parses a rig from TOML text and checks every parameter.
     pub fn from_toml_str(text: &str) -> Result<Self> {
-        let rig: RigSettings = toml::from_str(text).map_err(|e| Error::RigParse(e.to_string()))?;
+        let mut rig: RigSettings =
+            toml::from_str(text).map_err(|e| Error::RigParse(e.to_string()))?;
+        rig.spcr_defaults(text)?;
         rig.validate()?;
         Ok(rig)
+    }
+
+    /// Gives each `[[cloth]]` table that says `mode = "spcr"` SPCRJointDynamics' default
+    /// for the keys it leaves out where that differs from Tassel's
+    /// ([`crate::dynamics::cloth::ClothSettings::spcr`]).
+    fn spcr_defaults(&mut self, text: &str) -> Result<()> {
+        use crate::dynamics::cloth::ClothMode;
+        if self.cloths.iter().all(|c| c.mode != ClothMode::Spcr) {
+            return Ok(());
+        }
+        let table: toml::Table = text
+            .parse()
+            .map_err(|e: toml::de::Error| Error::RigParse(e.to_string()))?;
+        let given = table.get("cloth").and_then(|c| c.as_array());
+        for (i, cloth) in self.cloths.iter_mut().enumerate() {
+            if cloth.mode != ClothMode::Spcr {
+                continue;
+            }
+            let keys = given.and_then(|g| g.get(i)).and_then(|t| t.as_table());
+            for key in crate::dynamics::cloth::settings::SPCR_DEFAULTED_KEYS {
+                if !keys.is_some_and(|t| t.contains_key(key)) {
+                    cloth.set_spcr_default(key);
+                }
+            }
+        }
+        Ok(())
     }
 
     /// The rig as TOML text.

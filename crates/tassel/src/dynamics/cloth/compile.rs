@@ -58,6 +58,8 @@ pub(crate) struct CompiledCloth {
     /// The constraints by dependency level ([`dependency_levels`]), as the relaxation
     /// reads them.
     pub relaxed: Vec<Relaxed>,
+    /// In the `spcr` mode: SPCR's constraints, quads and per-point values.
+    pub spcr: Option<super::spcr::SpcrRig>,
 }
 
 /// A constraint as its relaxation reads it: ends, rest length, strengths, and the
@@ -377,7 +379,12 @@ impl ClothRig {
                 .iter()
                 .map(|&i| Relaxed::of(&out.constraints[i as usize], &out.fixed))
                 .collect();
+            let spcr = (s.mode == super::settings::ClothMode::Spcr).then(|| {
+                let tips: Vec<bool> = out.joint.iter().map(|j| j.is_none()).collect();
+                super::spcr::SpcrRig::build(s, &chains, &tips, &out.fixed)
+            });
             out.cloths.push(CompiledCloth {
+                spcr,
                 settings: s.clone(),
                 points: first..out.joint.len(),
                 chains,

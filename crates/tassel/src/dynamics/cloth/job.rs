@@ -3,6 +3,7 @@
 use super::compile::{ClothRig, ConstraintKind, Relaxed};
 use super::contact::{push_segment, push_triangle_against, Core};
 use super::lanes::{self as cloth_lanes, ClothLaneScratch};
+use super::spcr::{SpcrFrame, SpcrState};
 use crate::collide::PlacedCollider;
 use crate::controller::Level;
 use crate::dynamics::path::CharacterPath;
@@ -50,6 +51,8 @@ pub struct ClothState {
     simd: SimdUse,
     /// Scratch of the contact tests' lanes.
     lanes: ClothLaneScratch,
+    /// Per cloth, the state of the `spcr` mode (empty for `fixed` cloths).
+    spcr: Vec<SpcrState>,
 }
 
 impl ClothState {
@@ -96,6 +99,7 @@ impl ClothState {
             cores: Vec::new(),
             simd: SimdUse::default(),
             lanes: ClothLaneScratch::default(),
+            spcr: vec![SpcrState::default(); rig.cloths.len()],
         }
     }
 
@@ -206,6 +210,10 @@ impl ClothJob<'_> {
         gather(rig, models, &component, state);
         state.path.push(component, dt);
         for ci in 0..rig.cloths.len() {
+            if rig.cloths[ci].spcr.is_some() {
+                run_spcr(rig, ci, state, &component, dt, models);
+                continue;
+            }
             let level = level.filter(|_| rig.cloths[ci].settings.world_collision);
             run_cloth(rig, ci, state, &component, dt, level);
         }
@@ -215,6 +223,14 @@ impl ClothJob<'_> {
         state.prev_colliders_cs.copy_from_slice(&state.colliders_cs);
         state.prev_component = component;
         write_back(skeleton, rig, state, locals, models);
+        for (cloth, spcr) in rig.cloths.iter().zip(&mut state.spcr) {
+            if let Some(r) = &cloth.spcr {
+                let out = &mut state.out;
+                spcr.apply(
+                    cloth, r, &rig.joint, &component, skeleton, locals, models, out,
+                );
+            }
+        }
         crate::pose::LocalToModelJob {
             skeleton,
             root: Transform::IDENTITY,
@@ -276,19 +292,7 @@ fn run_cloth(
 ) {
     let cloth = &rig.cloths[ci];
     let s = &cloth.settings;
-    if !state.needs_reset[ci] {
-        let moved = (component.translation - state.prev_component.translation).length();
-        let turned = component
-            .rotation
-            .angle_between(state.prev_component.rotation)
-            .to_degrees();
-        if (s.teleport_distance > 0.0 && moved > s.teleport_distance)
-            || (s.teleport_angle > 0.0 && turned > s.teleport_angle)
-        {
-            state.needs_reset[ci] = true;
-            state.resets += 1;
-        }
-    }
+    check_teleport(s, ci, state, component);
     if state.needs_reset[ci] {
         reset_cloth(rig, ci, state);
         state.path.reset(*component);
@@ -375,6 +379,71 @@ fn run_cloth(
     let inv = component.inverse();
     for p in cloth.points.clone() {
         state.out[p] = inv.transform_point(state.out_world[p]);
+    }
+}
+
+/// Marks cloth `ci` for a reset when the character moved or turned farther than its
+/// teleport thresholds since the last frame.
+fn check_teleport(
+    s: &super::ClothSettings,
+    ci: usize,
+    state: &mut ClothState,
+    component: &Transform,
+) {
+    if state.needs_reset[ci] {
+        return;
+    }
+    let moved = (component.translation - state.prev_component.translation).length();
+    let turned = component
+        .rotation
+        .angle_between(state.prev_component.rotation)
+        .to_degrees();
+    if (s.teleport_distance > 0.0 && moved > s.teleport_distance)
+        || (s.teleport_angle > 0.0 && turned > s.teleport_angle)
+    {
+        state.needs_reset[ci] = true;
+        state.resets += 1;
+    }
+}
+
+/// One frame of cloth `ci` in the `spcr` mode ([`super::spcr`]): a reset (the first
+/// frame, a teleport, a non-finite point) rebuilds it on this frame's pose, as SPCR's
+/// `OnResetAll`.
+fn run_spcr(
+    rig: &ClothRig,
+    ci: usize,
+    state: &mut ClothState,
+    component: &Transform,
+    dt: f32,
+    models: &[Transform],
+) {
+    let cloth = &rig.cloths[ci];
+    let Some(spcr) = &cloth.spcr else { return };
+    check_teleport(&cloth.settings, ci, state, component);
+    let frame = SpcrFrame {
+        cloth,
+        spcr,
+        targets: &state.targets,
+        joint: &rig.joint,
+        models,
+        component,
+        colliders: &state.colliders,
+        dt,
+    };
+    let sim = &mut state.spcr[ci];
+    if state.needs_reset[ci] {
+        sim.reset(&frame);
+        sim.rest = 0.0;
+        state.needs_reset[ci] = false;
+    }
+    sim.frame(&frame, &mut state.rng[ci]);
+    if sim.pos.iter().any(|p| !p.is_finite()) {
+        state.resets += 1;
+        sim.reset(&frame);
+        sim.rest = 0.0;
+    }
+    for p in cloth.points.clone() {
+        state.out_world[p] = sim.pos[p - spcr.first].as_vec3();
     }
 }
 
@@ -708,7 +777,7 @@ fn write_back(
     locals: &mut [Transform],
     models: &mut [Transform],
 ) {
-    for cloth in &rig.cloths {
+    for cloth in rig.cloths.iter().filter(|c| c.spcr.is_none()) {
         for ch in &cloth.chains {
             for p in ch.start..ch.end.saturating_sub(1) {
                 let Some(j) = rig.joint[p] else { continue };

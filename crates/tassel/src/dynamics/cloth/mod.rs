@@ -13,10 +13,12 @@ pub(crate) mod compile;
 pub(crate) mod contact;
 mod job;
 pub(crate) mod lanes;
-mod settings;
+pub(crate) mod settings;
+pub(crate) mod spcr;
 
 pub use compile::{ClothConstraint, ClothRig, ConstraintKind};
 pub use job::{ClothJob, ClothState};
 pub use settings::{
-    ClothSettings, ClothWind, ConstraintSwitches, PointCurves, StrengthCurves, SurfaceCollision,
+    ClothMode, ClothSettings, ClothWind, CollisionSwitches, ConstraintSwitches, PointCurves,
+    StrengthCurves, SurfaceCollision,
 };

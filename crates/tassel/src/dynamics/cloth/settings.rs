@@ -85,6 +85,47 @@ pub enum SurfaceCollision {
     PushPull,
 }
 
+/// How a cloth steps.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ClothMode {
+    /// Tassel's own step: targets and colliders at each step's time, the output blended
+    /// between the last two steps and kept out of this frame's colliders. The same look
+    /// at every frame rate. The default.
+    #[default]
+    Fixed,
+    /// SPCRJointDynamicsUE4's update as its code runs it (`AnimNode_SPCRJointDynamics.cpp`):
+    /// every step of a frame aims at the frame's pose, colliders swept from the last
+    /// frame's place across the iterations, its gravity, resistance, drag, lift, wind and
+    /// collision rules, its constraint order, and the bones moved to the points. For a
+    /// user bringing an SPCR setup; the look depends on the frame rate as SPCR's does.
+    Spcr,
+}
+
+/// SPCRJointDynamics' per-family collision switches (`bStructural_Vertical_Collision`…):
+/// the families whose constraints push their points, and their segments, out of the
+/// colliders in the `spcr` mode.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct CollisionSwitches {
+    /// Along the chains (SPCR's default: on).
+    pub structural_vertical: bool,
+    /// Across the chains (SPCR's default: off).
+    pub structural_horizontal: bool,
+    /// Quad diagonals (SPCR's default: off).
+    pub shear: bool,
+}
+
+impl Default for CollisionSwitches {
+    fn default() -> Self {
+        Self {
+            structural_vertical: true,
+            structural_horizontal: false,
+            shear: false,
+        }
+    }
+}
+
 /// Wind on a cloth.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -96,6 +137,11 @@ pub struct ClothWind {
     pub gust: f32,
     /// Seed of the gust generator.
     pub seed: u64,
+    /// `spcr` mode only: SPCR's `WindForceSpeed`, radians per second of the wind's cycle
+    /// (the wind is `acceleration × (sin(phase)·0.5 + 0.5)`; 0 = no wind, as in SPCR).
+    /// Unset: 1, SPCR's default. The `fixed` mode does not read it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub speed: Option<f32>,
 }
 
 impl Default for ClothWind {
@@ -104,6 +150,7 @@ impl Default for ClothWind {
             acceleration: Vec3::ZERO,
             gust: 0.0,
             seed: 1,
+            speed: None,
         }
     }
 }
@@ -114,6 +161,11 @@ impl Default for ClothWind {
 pub struct ClothSettings {
     /// A name for messages.
     pub name: String,
+    /// How it steps: `fixed` (Tassel's, the default) or `spcr` (SPCRJointDynamicsUE4's
+    /// update). A rig file's `mode = "spcr"` also gives the keys it leaves out SPCR's
+    /// defaults ([`ClothSettings::spcr`]).
+    #[serde(skip_serializing_if = "is_fixed")]
+    pub mode: ClothMode,
     /// The chains, in order around or across the cloth: `[root bone, end bone]` pairs; each
     /// chain is the end bone and its ancestors up to the root bone.
     pub chains: Vec<[String; 2]>,
@@ -176,12 +228,38 @@ pub struct ClothSettings {
     pub teleport_angle: f32,
     /// Per-point parameter curves.
     pub curves: PointCurves,
+    /// `spcr` mode only: which families' constraints collide (SPCR's
+    /// `b…_Collision`). Unset: [`CollisionSwitches::default`], SPCR's.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub collision: Option<CollisionSwitches>,
+    /// `spcr` mode only: SPCR's `CollisionLOD`, 1..=4: the collision runs on every
+    /// `collision_lod`-th step of a frame, counted back from its last step. Unset: 2.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub collision_lod: Option<u32>,
+    /// `spcr` mode only: SPCR's `CollisionSubInterations`, 1..=10: collision passes per
+    /// iteration, the colliders swept across them. Unset: 1.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub collision_sub_iterations: Option<u32>,
+    /// `spcr` mode only: SPCR's `bLimitFromRoot`: the angle limit measures every segment
+    /// from its direction when the cloth was reset, not from its parent segment. Unset:
+    /// false.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub limit_from_root: Option<bool>,
+    /// `spcr` mode only: SPCR's `Structural_Vertical_StepCount`, 1..=8: how many times the
+    /// vertical structural constraints are listed (each relaxed in turn). Unset: 1.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub structural_vertical_step_count: Option<u32>,
+}
+
+fn is_fixed(mode: &ClothMode) -> bool {
+    *mode == ClothMode::Fixed
 }
 
 impl Default for ClothSettings {
     fn default() -> Self {
         Self {
             name: String::new(),
+            mode: ClothMode::Fixed,
             chains: Vec::new(),
             loop_chains: false,
             fixed_point_index: 0,
@@ -211,6 +289,50 @@ impl Default for ClothSettings {
             teleport_distance: 1.0,
             teleport_angle: 60.0,
             curves: PointCurves::default(),
+            collision: None,
+            collision_lod: None,
+            collision_sub_iterations: None,
+            limit_from_root: None,
+            structural_vertical_step_count: None,
+        }
+    }
+}
+
+/// The keys whose default differs in the `spcr` mode (SPCRJointDynamicsUE4's defaults),
+/// with Tassel's names.
+pub(crate) const SPCR_DEFAULTED_KEYS: [&str; 5] = [
+    "iterations",
+    "force_length_limit",
+    "surface_collision",
+    "max_steps_per_frame",
+    "radius",
+];
+
+impl ClothSettings {
+    /// A cloth in the `spcr` mode with SPCRJointDynamicsUE4's defaults where they differ
+    /// from Tassel's: one iteration (`MaxIterations`), no final length limit
+    /// (`bForceLengthLimit`), no surface collision (`bUseSurfaceCollision`), points
+    /// without a radius, and no step cap (the hitch guard at its largest, 64 steps).
+    pub fn spcr() -> Self {
+        let mut s = Self {
+            mode: ClothMode::Spcr,
+            ..Self::default()
+        };
+        for key in SPCR_DEFAULTED_KEYS {
+            s.set_spcr_default(key);
+        }
+        s
+    }
+
+    /// Sets `key` (one of [`SPCR_DEFAULTED_KEYS`]) to SPCR's default.
+    pub(crate) fn set_spcr_default(&mut self, key: &str) {
+        match key {
+            "iterations" => self.iterations = 1,
+            "force_length_limit" => self.force_length_limit = false,
+            "surface_collision" => self.surface_collision = SurfaceCollision::Off,
+            "max_steps_per_frame" => self.max_steps_per_frame = crate::limits::MAX_STEPS_PER_FRAME,
+            "radius" => self.radius = 0.0,
+            _ => {}
         }
     }
 }
@@ -311,6 +433,7 @@ impl ClothSettings {
                 }
             }
         }
+        self.validate_spcr_keys()?;
         let c = &self.curves;
         for (what, curve) in [
             ("resistance", &c.resistance),
@@ -322,6 +445,38 @@ impl ClothSettings {
             ("friction", &c.friction),
         ] {
             curve.validate(&format!("cloth '{name}': curves.{what}"))?;
+        }
+        Ok(())
+    }
+
+    /// The `spcr` mode's own keys in range.
+    fn validate_spcr_keys(&self) -> Result<()> {
+        let name = &self.name;
+        let range = |what: &str, v: Option<u32>, lo: u32, hi: u32| match v {
+            Some(v) if !(lo..=hi).contains(&v) => Err(Error::InvalidParameter(format!(
+                "cloth '{name}': {what} = {v} is out of range ({lo}..={hi})"
+            ))),
+            _ => Ok(()),
+        };
+        range("collision_lod", self.collision_lod, 1, 4)?;
+        range(
+            "collision_sub_iterations",
+            self.collision_sub_iterations,
+            1,
+            10,
+        )?;
+        range(
+            "structural_vertical_step_count",
+            self.structural_vertical_step_count,
+            1,
+            8,
+        )?;
+        if let Some(v) = self.wind.speed {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(Error::InvalidParameter(format!(
+                    "cloth '{name}': wind.speed = {v} is out of range (finite, ≥ 0)"
+                )));
+            }
         }
         Ok(())
     }
