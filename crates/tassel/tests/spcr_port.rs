@@ -11,8 +11,18 @@
 //! A 4 × 5 panel (4 chains of 5 bones, 0.1 m apart) hangs from a root that sways 0.2 m at
 //! 1 Hz (`sin`), jumps 0.2 m (`step`) or turns (`turn`, the character itself turning), at
 //! 30, 60 and 144 Hz, free, against a sphere and a capsule that swing through it, with the
-//! surface collision on and off. Every point within 1e-4 m of the port, every frame; each
-//! bone where its point is; each bone turned toward its child as SPCR turns it.
+//! surface collision on and off, with and without a virtual tip, hardness, drag, lift, wind,
+//! the angle lock, the length limit, two iterations and two collision sub-iterations;
+//! friction 0.3. Every point within 1e-5 m of the port, every frame (1e-4 m asked; 1.2e-7 m
+//! measured, the f32 output's rounding); each bone where its point is; each bone turned
+//! toward its child as SPCR turns it.
+//!
+//! The mode works in f64, as SPCR does on Unreal 5 (whose `FVector` is double). The port is
+//! given the pose, the bodies and the parameters as the engine holds them (f32), so that
+//! both meet the same numbers: SPCR's rules are not continuous (a point pushed onto a
+//! collider touches it or not by the last bit, then takes all of the friction or none; a
+//! hit crossing a triangle's edge; a capsule's end sphere taking over from its side), and
+//! two codes fed different roundings part at the first such contact.
 
 use glam::{DQuat, DVec3, Quat, Vec3};
 use tassel::dynamics::cloth::{
@@ -73,7 +83,28 @@ struct Params {
     sub: u32,
 }
 
+/// The case's parameters, each rounded to f32 as an engine's properties hold them (the
+/// rig gets the same values).
 fn params(c: &Case) -> Params {
+    let p = exact_params(c);
+    let r = |x: f64| x as f32 as f64;
+    let v = |x: DVec3| x.as_vec3().as_dvec3();
+    Params {
+        resistance: r(p.resistance),
+        hardness: r(p.hardness),
+        gravity: v(p.gravity),
+        tip: r(p.tip),
+        limit: r(p.limit),
+        wind: v(p.wind),
+        wind_speed: r(p.wind_speed),
+        drag: r(p.drag),
+        lift: r(p.lift),
+        friction: r(p.friction),
+        ..p
+    }
+}
+
+fn exact_params(c: &Case) -> Params {
     Params {
         resistance: 0.05,
         hardness: if c.extras { 0.02 } else { 0.0 },
@@ -90,10 +121,7 @@ fn params(c: &Case) -> Params {
         wind_speed: 2.0,
         drag: if c.extras { 0.5 } else { 0.0 },
         lift: if c.extras { 0.3 } else { 0.0 },
-        // SPCR's friction is all or nothing per contact, and a point pushed onto a
-        // collider's surface then touches it, or not, by rounding: with friction the two
-        // f64 codes part at the first grazing contact (see the module's notes).
-        friction: 0.0,
+        friction: 0.3,
         lod: 2,
         sub: if c.extras { 2 } else { 1 },
     }
@@ -235,6 +263,37 @@ fn rig(c: &Case) -> RigSettings {
     rig
 }
 
+/// The animated locals (the root and the body moved) and the character's transform at
+/// time `t`, in f32 as an engine holds them.
+fn animated(sk: &Skeleton, m: Motion, t: f64) -> (Vec<Transform>, Transform) {
+    let mut locals = sk.rest().to_vec();
+    let (rt, rr) = root_at(m, t);
+    locals[sk.find("root").unwrap()] =
+        Transform::from_translation_rotation(rt.as_vec3(), rr.as_quat());
+    let (bt, br) = body_at(t);
+    locals[sk.find("body").unwrap()] =
+        Transform::from_translation_rotation(bt.as_vec3(), br.as_quat());
+    let (ct, cr) = component_at(m, t);
+    (
+        locals,
+        Transform::from_translation_rotation(ct.as_vec3(), cr.as_quat()),
+    )
+}
+
+/// The component-space transforms of `locals` (the engine's pose, which SPCR reads).
+fn models_of(sk: &Skeleton, locals: &[Transform]) -> Vec<Transform> {
+    let mut models = vec![Transform::IDENTITY; sk.len()];
+    tassel::LocalToModelJob {
+        skeleton: sk,
+        root: Transform::IDENTITY,
+        locals,
+        models: &mut models,
+    }
+    .run()
+    .unwrap();
+    models
+}
+
 // ---------------------------------------------------------------- the port (f64)
 
 /// Unreal's `FMath::Clamp` (NaN gives the upper bound).
@@ -329,26 +388,31 @@ struct Frame {
     comp: (DVec3, DQuat),
     /// [chain][bone]: (position, rotation) in component space.
     bones: Vec<Vec<(DVec3, DQuat)>>,
-    body: (DVec3, DQuat),
+    /// The body collider's bone, world (f32, as the engine gives it).
+    body: Transform,
 }
 
 impl Frame {
-    fn at(m: Motion, t: f64) -> Frame {
-        let (rt, rr) = root_at(m, t);
+    /// The pose as the engine hands it to SPCR: the bones' component-space transforms
+    /// (`models`, f32) and the component's (f32); the body's world transform is the f32
+    /// product the engine forms (`BoneCSTransform * ComponentTransform`).
+    fn of(sk: &Skeleton, models: &[Transform], comp: Transform) -> Frame {
         let bones = (0..CHAINS)
             .map(|c| {
                 (0..BONES)
                     .map(|i| {
-                        let local = DVec3::new(c as f64 * SEG, TOP - i as f64 * SEG, 0.0);
-                        (rt + rr * local, rr)
+                        let m = models[sk.find(&format!("c{c}_{i}")).unwrap()];
+                        (m.translation.as_dvec3(), m.rotation.as_dquat())
                     })
                     .collect()
             })
             .collect();
+        let b = models[sk.find("body").unwrap()];
+        let body = comp * Transform::from_translation_rotation(b.translation, b.rotation);
         Frame {
-            comp: component_at(m, t),
+            comp: (comp.translation.as_dvec3(), comp.rotation.as_dquat()),
             bones,
-            body: body_at(t),
+            body,
         }
     }
 
@@ -458,19 +522,18 @@ impl Port {
     }
 
     /// The body collider's SPCR place on frame `f`: bottom end, full axis, radius, height.
+    /// Its ends come from the engine's f32 transform, as Unreal hands SPCR its bodies.
     fn body_place(&self, f: &Frame) -> (DVec3, DVec3, f64, f64) {
-        let centre = f.to_world(f.body.0);
-        let rot = f.comp.1 * f.body.1;
+        let centre = f.body.translation;
         match self.case.body {
             Body::Capsule => {
-                let half = CAPSULE_LEN * 0.5;
+                let len = CAPSULE_LEN as f32;
                 // Tassel's capsules run along their bone's +Y (Unreal's along Z).
-                let axis = rot * DVec3::Y;
-                let top = centre + axis * half;
-                let bottom = centre - axis * half;
-                (bottom, top - bottom, CAPSULE_R, half * 2.0)
+                let axis = f.body.rotation * Vec3::Y * (0.5 * len);
+                let (bottom, top) = ((centre - axis).as_dvec3(), (centre + axis).as_dvec3());
+                (bottom, top - bottom, CAPSULE_R as f32 as f64, len as f64)
             }
-            _ => (centre, DVec3::ZERO, SPHERE_R, 0.0),
+            _ => (centre.as_dvec3(), DVec3::ZERO, SPHERE_R as f32 as f64, 0.0),
         }
     }
 
@@ -586,7 +649,7 @@ impl Port {
                 }
                 wind = self.p.wind * (self.wind_radians.sin() * 0.5 + 0.5);
             }
-            self.update_control_points(f, wind, one_step as f64);
+            self.update_control_points(f, wind, one_step);
             for relax in 1..=self.p.iterations {
                 let delta = relax as f64 / self.p.iterations as f64;
                 self.update_colliders(f, delta);
@@ -615,8 +678,9 @@ impl Port {
         }
     }
 
-    fn update_control_points(&mut self, f: &Frame, wind: DVec3, h: f64) {
-        let half = h * h * 0.5;
+    fn update_control_points(&mut self, f: &Frame, wind: DVec3, h: f32) {
+        // `const float StepTime_x2_Half = DeltaTime * DeltaTime * 0.5f;`
+        let half = (h * h * 0.5) as f64;
         let g = self.p.gravity;
         for c in 0..self.pts.len() {
             // `while (iPoint <= FixedPointIndex)`, with FixedPointIndex 0.
@@ -805,8 +869,7 @@ impl Port {
                 let remaining = angle - self.p.limit;
                 if remaining > 0.0 {
                     let axis = safe(parent_dir.cross(bone));
-                    let rot = DQuat::from_axis_angle(axis, (-remaining).to_radians());
-                    self.pts[c][i].pos = parent.pos + rot * bone;
+                    self.pts[c][i].pos = parent.pos + rotate_angle_axis(bone, -remaining, axis);
                 }
             }
         }
@@ -845,6 +908,20 @@ impl Port {
             }
         }
     }
+}
+
+/// Unreal's `FVector::RotateAngleAxis(AngleDeg, Axis)` (its rotation matrix, written out).
+fn rotate_angle_axis(v: DVec3, angle_deg: f64, axis: DVec3) -> DVec3 {
+    let (s, c) = angle_deg.to_radians().sin_cos();
+    let (xx, yy, zz) = (axis.x * axis.x, axis.y * axis.y, axis.z * axis.z);
+    let (xy, yz, zx) = (axis.x * axis.y, axis.y * axis.z, axis.z * axis.x);
+    let (xs, ys, zs) = (axis.x * s, axis.y * s, axis.z * s);
+    let omc = 1.0 - c;
+    DVec3::new(
+        (omc * xx + c) * v.x + (omc * xy - zs) * v.y + (omc * zx + ys) * v.z,
+        (omc * xy + zs) * v.x + (omc * yy + c) * v.y + (omc * yz - xs) * v.z,
+        (omc * zx - ys) * v.x + (omc * yz + xs) * v.y + (omc * zz + c) * v.z,
+    )
 }
 
 /// `FQuat::FindBetweenNormals`.
@@ -1046,22 +1123,14 @@ fn run(case: Case) -> (f64, f64, f64, f64) {
     let mut sim = CharacterSim::new(sk.clone(), &rig(&case)).unwrap();
     let frames = (2.0 * case.rate).round() as usize;
     let dt = (1.0 / case.rate) as f32;
-    let root = sk.find("root").unwrap();
-    let body = sk.find("body").unwrap();
     let mut port: Option<Port> = None;
     let (mut worst, mut worst_bone, mut worst_turn, mut moved) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
     let mut start = Vec::new();
     for f in 0..frames {
         let t = f as f64 / case.rate;
         let step = if f == 0 { 0.0 } else { dt };
-        let frame = Frame::at(case.motion, t);
-        let mut locals = sk.rest().to_vec();
-        let (rt, rr) = root_at(case.motion, t);
-        locals[root] = Transform::from_translation_rotation(rt.as_vec3(), rr.as_quat());
-        let (bt, br) = body_at(t);
-        locals[body] = Transform::from_translation_rotation(bt.as_vec3(), br.as_quat());
-        let (ct, cr) = frame.comp;
-        let comp = Transform::from_translation_rotation(ct.as_vec3(), cr.as_quat());
+        let (locals, comp) = animated(&sk, case.motion, t);
+        let frame = Frame::of(&sk, &models_of(&sk, &locals), comp);
         let pose = sim.frame(&locals, comp, step).unwrap().clone();
         let port = port.get_or_insert_with(|| Port::new(case, &frame));
         port.evaluate(&frame, step);
@@ -1134,16 +1203,10 @@ fn spcr_mode_follows_the_f64_port_of_spcr_within_1e4_m() {
             case.rate, case.motion, case.body, case.surface, case.extras
         );
         assert!(moved > 0.02, "{case:?}: the cloth hardly moved ({moved} m)");
-        // With the extras (angle lock, two sub-iterations, the length limit) against a
-        // collider, SPCR's contact rules are not continuous (a hit point crossing a
-        // triangle's edge, a capsule's end sphere taking over from its side): 6 of these
-        // 36 cases part at such a contact by 2.5e-4–1.6e-3 m. Every other case: 1e-4.
-        let bound = if case.extras && case.body != Body::None {
-            2e-3
-        } else {
-            1e-4
-        };
-        if !(gap <= bound && bone <= bound && turn <= bound * 10.0) {
+        // The issue asks for 1e-4 m; the two f64 codes agree to the f32 output's rounding
+        // (1.2e-7 m measured), so a tenth of the way there is already a regression.
+        let bound = 1e-5;
+        if !(gap <= bound && bone <= bound && turn <= 1e-3) {
             failures.push(format!(
                 "{case:?}: {gap:.2e} m / {bone:.2e} m / {turn:.2e} rad"
             ));
@@ -1270,22 +1333,15 @@ fn samples(case: Case, mode: Option<ClothMode>) -> Vec<Vec<DVec3>> {
     let frames = (2.0 * case.rate).round() as usize;
     let dt = (1.0 / case.rate) as f32;
     let per_sample = (case.rate / 6.0).round() as usize;
-    let (root, body) = (sk.find("root").unwrap(), sk.find("body").unwrap());
     let mut port: Option<Port> = None;
     let mut out = Vec::new();
     for f in 0..=frames {
         let t = f as f64 / case.rate;
         let step = if f == 0 { 0.0 } else { dt };
-        let frame = Frame::at(case.motion, t);
+        let (locals, comp) = animated(&sk, case.motion, t);
+        let frame = Frame::of(&sk, &models_of(&sk, &locals), comp);
         let points: Vec<DVec3> = match mode {
             Some(_) => {
-                let mut locals = sk.rest().to_vec();
-                let (rt, rr) = root_at(case.motion, t);
-                locals[root] = Transform::from_translation_rotation(rt.as_vec3(), rr.as_quat());
-                let (bt, br) = body_at(t);
-                locals[body] = Transform::from_translation_rotation(bt.as_vec3(), br.as_quat());
-                let (ct, cr) = frame.comp;
-                let comp = Transform::from_translation_rotation(ct.as_vec3(), cr.as_quat());
                 sim.frame(&locals, comp, step).unwrap();
                 let w = sim.cloth_state().world_positions();
                 w.iter().map(|p| p.as_dvec3()).collect()
@@ -1326,14 +1382,13 @@ fn fixed_keeps_its_look_across_frame_rates_where_spcr_does_not() {
             rate,
             extras: false,
         };
-        let spcr: Vec<_> = [30.0, 60.0, 144.0]
-            .map(|r| samples(case(r), None))
-            .into();
+        let spcr: Vec<_> = [30.0, 60.0, 144.0].map(|r| samples(case(r), None)).into();
         let fixed: Vec<_> = [30.0, 60.0, 144.0]
             .map(|r| samples(case(r), Some(ClothMode::Fixed)))
             .into();
         let apart = largest_gap(&fixed[1], &spcr[1]);
-        let spread = |s: &[Vec<Vec<DVec3>>]| largest_gap(&s[0], &s[1]).max(largest_gap(&s[1], &s[2]));
+        let spread =
+            |s: &[Vec<Vec<DVec3>>]| largest_gap(&s[0], &s[1]).max(largest_gap(&s[1], &s[2]));
         let (spcr_spread, fixed_spread) = (spread(&spcr), spread(&fixed));
         println!(
             "{motion:?}: fixed vs SPCR at 60 Hz {:.2} cm; across 30/60/144 Hz SPCR moves {:.2} cm, fixed {:.4} cm",
