@@ -12,6 +12,7 @@ use glam::{Quat, Vec3};
 use std::path::Path;
 use std::sync::OnceLock;
 use tassel::anim::{Playback, SamplingCursor, SamplingJob, StateMachine};
+use tassel::dynamics::cloth::{ClothMode, CollisionSwitches};
 use tassel::dynamics::vrm::{
     VrmCollider, VrmColliderGroup, VrmJoint, VrmLimit, VrmLimitShape, VrmMode, VrmOptions,
     VrmShape, VrmSpring, VrmSpringBones, VrmTail,
@@ -360,7 +361,25 @@ pub fn simulation(data: &[u8]) {
     match u.int_in_range(0..=4).unwrap_or(0) {
         0 => rig.chains = full.chains.clone(),
         1 => rig.springs = full.springs.clone(),
-        2 => rig.cloths = full.cloths.clone(),
+        2 => {
+            rig.cloths = full.cloths.clone();
+            // Half of the cloth inputs run the spcr mode with its own keys set.
+            if u.ratio(1, 2).unwrap_or(false) {
+                for c in &mut rig.cloths {
+                    c.mode = ClothMode::Spcr;
+                    c.collision_lod = Some(u.int_in_range(1..=4).unwrap_or(2));
+                    c.collision_sub_iterations = Some(u.int_in_range(1..=10).unwrap_or(1));
+                    c.structural_vertical_step_count = Some(u.int_in_range(1..=8).unwrap_or(1));
+                    c.limit_from_root = Some(u.arbitrary().unwrap_or(false));
+                    c.wind.speed = Some(2.0);
+                    c.collision = Some(CollisionSwitches {
+                        structural_vertical: true,
+                        structural_horizontal: u.arbitrary().unwrap_or(true),
+                        shear: u.arbitrary().unwrap_or(true),
+                    });
+                }
+            }
+        }
         3 => rig.ropes = full.ropes.clone(),
         _ => rig = full.clone(),
     }

@@ -139,7 +139,7 @@ pub struct ClothWind {
     pub seed: u64,
     /// `spcr` mode only: SPCR's `WindForceSpeed`, radians per second of the wind's cycle
     /// (the wind is `acceleration × (sin(phase)·0.5 + 0.5)`; 0 = no wind, as in SPCR).
-    /// Unset: 1, SPCR's default. The `fixed` mode does not read it.
+    /// Unset: 1, SPCR's default; at most 10 000. The `fixed` mode does not read it.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub speed: Option<f32>,
 }
@@ -472,9 +472,9 @@ impl ClothSettings {
             8,
         )?;
         if let Some(v) = self.wind.speed {
-            if !(v.is_finite() && v >= 0.0) {
+            if !(v.is_finite() && (0.0..=10_000.0).contains(&v)) {
                 return Err(Error::InvalidParameter(format!(
-                    "cloth '{name}': wind.speed = {v} is out of range (finite, ≥ 0)"
+                    "cloth '{name}': wind.speed = {v} is out of range (0..=10000 rad/s)"
                 )));
             }
         }

@@ -569,6 +569,10 @@ impl SpcrState {
             let mut wind = DVec3::ZERO;
             if f.spcr.wind_speed > 0.0 {
                 self.wind_phase += f64::from(h) * f.spcr.wind_speed;
+                if self.wind_phase.abs() > 1e6 {
+                    // SPCR's loops below would not end (a turn is lost in the rounding).
+                    self.wind_phase %= SPCR_PI * 2.0;
+                }
                 while self.wind_phase > SPCR_PI {
                     self.wind_phase -= SPCR_PI * 2.0;
                 }
