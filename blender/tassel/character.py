@@ -7,7 +7,14 @@ import numpy as np
 
 from . import native, pose, springs
 
-MODES = {"FIXED": "fixed", "SPEC": "spec", "THREE_VRM": "three-vrm", "CLASSIC": "classic", "KAWAII": "kawaii"}
+MODES = {
+    "FIXED": "fixed",
+    "SPEC": "spec",
+    "THREE_VRM": "three-vrm",
+    "CLASSIC": "classic",
+    "KAWAII": "kawaii",
+    "SPCR": "spcr",
+}
 
 # The modes as Blender's enum items (identifier, name, description), shared by the panel's
 # setting and the operator.
@@ -17,6 +24,7 @@ MODE_ITEMS = [
     ("THREE_VRM", "three-vrm", "VRM springs as three-vrm 3.5.5 runs them"),
     ("CLASSIC", "Classic", "Chains frame by frame, as KawaiiPhysics 1.10"),
     ("KAWAII", "KawaiiPhysics 1.21", "Chains as KawaiiPhysics 1.21's fixed substepping runs them"),
+    ("SPCR", "SPCR", "Bone cloths as SPCRJointDynamicsUE4's update runs them"),
 ]
 DEFAULT_STEP_RATE = 60.0
 

@@ -425,7 +425,32 @@ impl Frame {
     }
 }
 
+/// One of Tassel's `fixed` choices put into the port in SPCR's place (the table of
+/// `docs/cloth.md`): each switched on alone measures what that difference moves.
+#[derive(Clone, Copy, Default, Debug)]
+struct Variant {
+    /// The fixed points at each step's time (linearly between the frames), not on the
+    /// frame's end pose at every step.
+    step_targets: bool,
+    /// The output blended between the last two steps (one step behind, as `fixed`), not
+    /// the last step.
+    blend_output: bool,
+    /// The bones only turned toward their child (their places from their parents), not
+    /// moved to the points.
+    turn_only: bool,
+    /// The constraints per chain, then per pair of chains, without the bottom row's
+    /// clamped pairs.
+    tassel_order: bool,
+    /// `d = (v(1 − r) + g·h²)(1 − f)`, not `d = (g·h²/2 + v)(1 − r)(1 − f)`.
+    tassel_gravity: bool,
+}
+
 struct Port {
+    variant: Variant,
+    /// The fixed points' world places at the last frame's end (for `step_targets`).
+    last_frame: Vec<DVec3>,
+    /// Every point after the step before the last (for `blend_output`).
+    before: Vec<Vec<DVec3>>,
     p: Params,
     case: Case,
     pts: Vec<Vec<Point>>,
@@ -442,6 +467,11 @@ struct Port {
 impl Port {
     /// `OnResetAll` on frame `f`.
     fn new(case: Case, f: &Frame) -> Port {
+        Port::with(case, f, Variant::default())
+    }
+
+    /// The port with one of Tassel's choices in SPCR's place.
+    fn with(case: Case, f: &Frame, variant: Variant) -> Port {
         let p = params(&case);
         let need_virtual = p.tip > 0.0;
         let mut pts = Vec::new();
@@ -487,7 +517,15 @@ impl Port {
             }
             pts.push(chain);
         }
+        let last_frame = (0..CHAINS).map(|c| f.bone_world(c, 0)).collect();
+        let before = pts
+            .iter()
+            .map(|ch: &Vec<Point>| ch.iter().map(|q| q.pos).collect())
+            .collect();
         let mut port = Port {
+            variant,
+            last_frame,
+            before,
             p,
             case,
             pts,
@@ -553,6 +591,9 @@ impl Port {
     /// `CreateConstraints`: bending horizontal, bending vertical, shear, structural
     /// horizontal, structural vertical. The panel is not a loop.
     fn create_constraints(&mut self) {
+        if self.variant.tassel_order {
+            return self.create_constraints_tassel_order();
+        }
         let n = self.pts.len();
         let len = |port: &Port, t: usize| port.pts[t].len();
         // Bending horizontal (no collision).
@@ -613,6 +654,40 @@ impl Port {
         }
     }
 
+    /// (Variant) Tassel's order: per chain (structural, then bending along it), then per
+    /// pair of chains (structural across, both shear diagonals of each quad), then bending
+    /// across; no clamped pairs past the shorter chain.
+    fn create_constraints_tassel_order(&mut self) {
+        let n = self.pts.len();
+        for t in 0..n {
+            let len = self.pts[t].len();
+            for i in 0..len {
+                if i + 1 < len {
+                    self.add(Kind::StructuralVertical, (t, i), (t, i + 1), true);
+                }
+                if i + 2 < len {
+                    self.add(Kind::BendingVertical, (t, i), (t, i + 2), false);
+                }
+            }
+        }
+        for t in 0..n - 1 {
+            let m = self.pts[t].len().min(self.pts[t + 1].len());
+            for i in 0..m {
+                self.add(Kind::StructuralHorizontal, (t, i), (t + 1, i), true);
+                if i + 1 < m {
+                    self.add(Kind::Shear, (t, i), (t + 1, i + 1), false);
+                    self.add(Kind::Shear, (t + 1, i), (t, i + 1), false);
+                }
+            }
+        }
+        for t in 0..n.saturating_sub(2) {
+            let m = self.pts[t].len().min(self.pts[t + 2].len());
+            for i in 0..m {
+                self.add(Kind::BendingHorizontal, (t, i), (t + 2, i), false);
+            }
+        }
+    }
+
     /// `CreateSurfaceConstraints`.
     fn create_surfaces(&mut self) {
         let n = self.pts.len();
@@ -633,11 +708,20 @@ impl Port {
 
     /// `EvaluateSkeletalControl_AnyThread` for a frame of `dt` seconds ending on `f`.
     fn evaluate(&mut self, f: &Frame, dt: f32) {
+        let start = self.rest;
         self.rest += dt;
         let one_step: f32 = 1.0 / 120.0;
         let loops = (self.rest / one_step) as i32;
         for i in (0..loops).rev() {
             self.rest -= one_step;
+            // (Variant) where this step's end lies in the frame.
+            let k = (loops - i) as f64;
+            let w = ((k * one_step as f64 - start as f64) / dt as f64).clamp(0.0, 1.0);
+            self.before = self
+                .pts
+                .iter()
+                .map(|ch| ch.iter().map(|q| q.pos).collect())
+                .collect();
             let mut wind = DVec3::ZERO;
             if self.p.wind_speed > 0.0 {
                 self.wind_radians += one_step as f64 * self.p.wind_speed;
@@ -649,7 +733,7 @@ impl Port {
                 }
                 wind = self.p.wind * (self.wind_radians.sin() * 0.5 + 0.5);
             }
-            self.update_control_points(f, wind, one_step);
+            self.update_control_points(f, wind, one_step, w);
             for relax in 1..=self.p.iterations {
                 let delta = relax as f64 / self.p.iterations as f64;
                 self.update_colliders(f, delta);
@@ -672,13 +756,14 @@ impl Port {
             self.force_fix_constraints();
         }
         self.apply_to_bone(f);
+        self.last_frame = (0..CHAINS).map(|c| f.bone_world(c, 0)).collect();
         for c in &mut self.colliders {
             c.position_prev_frame = c.position;
             c.direction_prev_frame = c.direction;
         }
     }
 
-    fn update_control_points(&mut self, f: &Frame, wind: DVec3, h: f32) {
+    fn update_control_points(&mut self, f: &Frame, wind: DVec3, h: f32, w: f64) {
         // `const float StepTime_x2_Half = DeltaTime * DeltaTime * 0.5f;`
         let half = (h * h * 0.5) as f64;
         let g = self.p.gravity;
@@ -687,7 +772,10 @@ impl Port {
             let fixed_point_index = 0;
             let mut i = 0;
             while i <= fixed_point_index {
-                let here = f.bone_world(c, i);
+                let mut here = f.bone_world(c, i);
+                if self.variant.step_targets {
+                    here = lerp(self.last_frame[c], here, w);
+                }
                 self.pts[c][i].pos = here;
                 self.pts[c][i].prev = here;
                 i += 1;
@@ -700,6 +788,11 @@ impl Port {
                 d += pt.pos - pt.prev;
                 d *= pt.resistance;
                 d *= 1.0 - clamp(pt.friction, 0.0, 1.0);
+                if self.variant.tassel_gravity {
+                    let h2 = (h as f64) * (h as f64);
+                    d = ((pt.pos - pt.prev) * pt.resistance + (g * pt.gravity + wind) * h2)
+                        * (1.0 - clamp(pt.friction, 0.0, 1.0));
+                }
                 if self.p.drag > 0.0 {
                     let speed = d.length_squared();
                     let n = safe(d);
@@ -889,22 +982,44 @@ impl Port {
     fn apply_to_bone(&mut self, f: &Frame) {
         let inv = f.comp.1.inverse();
         let cs = |p: DVec3| inv * (p - f.comp.0);
+        let share = (self.rest / (1.0f32 / 120.0)) as f64;
         for c in 0..self.pts.len() {
+            // What is shown: the last step (SPCR), or (variant) the blend of the last two.
+            let shown: Vec<DVec3> = (0..self.pts[c].len())
+                .map(|i| {
+                    let p = self.pts[c][i].pos;
+                    if self.variant.blend_output {
+                        cs(lerp(self.before[c][i], p, share))
+                    } else {
+                        cs(p)
+                    }
+                })
+                .collect();
+            let mut turned_parent: Option<(DVec3, DQuat)> = None;
             for i in 0..BONES {
                 let (bp, br) = f.bones[c][i];
                 let mut rot = br;
+                let mut add = DQuat::IDENTITY;
                 if i + 1 < self.pts[c].len() {
                     let child = self.pts[c][i + 1];
-                    let to_target = cs(self.pts[c][i].pos) - cs(child.pos);
+                    let to_target = shown[i] - shown[i + 1];
                     let to_current = if !child.real {
                         br * self.pts[c][i].cs_bone_dir
                     } else {
                         bp - f.bones[c][i + 1].0
                     };
-                    let add = find_between_normals(safe(to_current), safe(to_target));
+                    add = find_between_normals(safe(to_current), safe(to_target));
                     rot = add * br;
                 }
-                self.out[c][i] = (cs(self.pts[c][i].pos), rot);
+                let at = match turned_parent {
+                    // (Variant) the bone where its turned parent takes it.
+                    Some((parent_at, parent_add)) if self.variant.turn_only => {
+                        parent_at + parent_add * (bp - f.bones[c][i - 1].0)
+                    }
+                    _ => shown[i],
+                };
+                turned_parent = Some((at, add));
+                self.out[c][i] = (at, rot);
             }
         }
     }
@@ -1403,5 +1518,84 @@ fn fixed_keeps_its_look_across_frame_rates_where_spcr_does_not() {
             motion == Motion::Step || fixed_spread * 10.0 < spcr_spread,
             "{motion:?}: fixed spreads {fixed_spread} m across frame rates, SPCR {spcr_spread} m"
         );
+    }
+}
+
+/// The written bones (character space) of every frame of `case` through the port with
+/// `variant`.
+fn port_output(case: Case, variant: Variant) -> Vec<Vec<DVec3>> {
+    let sk = skeleton();
+    let frames = (2.0 * case.rate).round() as usize;
+    let dt = (1.0 / case.rate) as f32;
+    let mut port: Option<Port> = None;
+    let mut out = Vec::new();
+    for f in 0..frames {
+        let t = f as f64 / case.rate;
+        let (locals, comp) = animated(&sk, case.motion, t);
+        let frame = Frame::of(&sk, &models_of(&sk, &locals), comp);
+        let port = port.get_or_insert_with(|| Port::with(case, &frame, variant));
+        port.evaluate(&frame, if f == 0 { 0.0 } else { dt });
+        out.push(port.out.iter().flatten().map(|(p, _)| *p).collect());
+    }
+    out
+}
+
+/// The table of `docs/cloth.md`: each of Tassel's `fixed` choices put alone into the port
+/// in SPCR's place, on the free panel at 60 Hz, swaying (0.2 m, 1 Hz) and stepping
+/// (0.2 m): how far the written bones move from SPCR's. Each must move them (a switch
+/// that moves nothing measures nothing).
+#[test]
+fn each_difference_from_spcr_measured_alone() {
+    let rows: [(&str, Variant); 5] = [
+        (
+            "targets at each step's time",
+            Variant {
+                step_targets: true,
+                ..Variant::default()
+            },
+        ),
+        (
+            "output blended from the last two steps",
+            Variant {
+                blend_output: true,
+                ..Variant::default()
+            },
+        ),
+        (
+            "bones turned, not moved",
+            Variant {
+                turn_only: true,
+                ..Variant::default()
+            },
+        ),
+        (
+            "constraints per chain, then per pair",
+            Variant {
+                tassel_order: true,
+                ..Variant::default()
+            },
+        ),
+        (
+            "gravity and resistance as fixed",
+            Variant {
+                tassel_gravity: true,
+                ..Variant::default()
+            },
+        ),
+    ];
+    for motion in [Motion::Sin, Motion::Step] {
+        let case = Case {
+            motion,
+            body: Body::None,
+            surface: false,
+            rate: 60.0,
+            extras: false,
+        };
+        let base = port_output(case, Variant::default());
+        for (what, variant) in rows {
+            let gap = largest_gap(&base, &port_output(case, variant));
+            println!("{motion:?}: {what}: {:.2} cm", gap * 100.0);
+            assert!(gap > 1e-5, "{motion:?}: {what} moved nothing ({gap} m)");
+        }
     }
 }
