@@ -1599,3 +1599,58 @@ fn each_difference_from_spcr_measured_alone() {
         }
     }
 }
+
+/// A hitch of a day, NaN in the pose and a teleport: the spcr cloth steps at most
+/// `max_steps_per_frame` steps, gives an error for the NaN and no NaN after it, resets on
+/// the teleport, and keeps stepping at the next ordinary frame (no stall from the time it
+/// dropped).
+#[test]
+fn an_spcr_cloth_recovers_from_a_hitch_nan_and_a_teleport() {
+    let sk = skeleton();
+    let case = Case {
+        motion: Motion::Sin,
+        body: Body::Capsule,
+        surface: true,
+        rate: 60.0,
+        extras: true,
+    };
+    let mut settings = rig(&case);
+    settings.cloths[0].teleport_distance = 1.0;
+    let mut sim = CharacterSim::new(sk.clone(), &settings).unwrap();
+    let (locals, comp) = animated(&sk, Motion::Sin, 0.0);
+    sim.frame(&locals, comp, 0.0).unwrap();
+    let before: Vec<Vec3> = sim.cloth_state().world_positions().to_vec();
+    for hitch in [1e3f32, 86_400.0, 1e6, 3e7] {
+        sim.frame(&locals, comp, hitch).unwrap();
+        // Each of the next ordinary frames still moves the cloth (steps are taken: the
+        // dropped time leaves no debt behind).
+        for k in 1..=5 {
+            let (locals, comp) = animated(&sk, Motion::Sin, 0.1 * k as f64);
+            let was: Vec<Vec3> = sim.cloth_state().world_positions().to_vec();
+            sim.frame(&locals, comp, 1.0 / 60.0).unwrap();
+            let now = sim.cloth_state().world_positions();
+            assert!(
+                now.iter().zip(&was).any(|(a, b)| (*a - *b).length() > 1e-6),
+                "frame {k} after a hitch of {hitch} s took no step"
+            );
+            assert!(now.iter().all(|p| p.is_finite()));
+        }
+    }
+    assert!(before.iter().all(|p| p.is_finite()));
+    let mut bad = locals.clone();
+    bad[sk.find("root").unwrap()].translation.x = f32::NAN;
+    assert!(sim.frame(&bad, comp, 1.0 / 60.0).is_err());
+    let (locals, comp) = animated(&sk, Motion::Sin, 0.7);
+    let resets = sim.cloth_state().reset_count();
+    let far = Transform::from_translation(Vec3::new(50.0, 0.0, 0.0));
+    let pose = sim.frame(&locals, far, 1.0 / 60.0).unwrap().clone();
+    assert_eq!(
+        sim.cloth_state().reset_count(),
+        resets + 1,
+        "the teleport resets"
+    );
+    assert!(pose.models.iter().all(|m| m.is_finite()));
+    // After the reset the points are on the animated pose, carried by the character.
+    let w = sim.cloth_state().world_positions();
+    assert!(w.iter().all(|p| p.x > 49.0), "the cloth came along: {w:?}");
+}

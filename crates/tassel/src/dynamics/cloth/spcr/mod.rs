@@ -164,7 +164,10 @@ impl SpcrState {
         let mut loops = (self.rest / h) as i64;
         let cap = i64::from(s.max_steps_per_frame);
         if loops > cap {
-            self.rest -= (loops - cap) as f32 * h;
+            // The hitch guard (SPCR has none): the steps beyond it are dropped, the part of
+            // a step left over kept. (Subtracting the dropped time would lose the rest to
+            // f32 rounding after a long hitch and stall the next frames.)
+            self.rest = self.rest % h + cap as f32 * h;
             loops = cap;
         }
         for i in (0..loops).rev() {
