@@ -523,3 +523,27 @@ pub(crate) fn write(t: &Transform, out: &mut [f32]) {
     out[3..7].copy_from_slice(&t.rotation.to_array());
     out[7..10].copy_from_slice(&t.scale.to_array());
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every mode the C ABI and the web take by name is the CLI's `--mode` name, and a name
+    /// that is none of them is refused with the list.
+    #[test]
+    fn every_mode_parses_by_its_name() {
+        for (name, mode) in [
+            ("fixed", SimMode::Fixed),
+            ("spec", SimMode::Spec),
+            ("three-vrm", SimMode::ThreeVrm),
+            ("classic", SimMode::Classic),
+            ("kawaii", SimMode::Kawaii),
+            ("spcr", SimMode::Spcr),
+        ] {
+            assert_eq!(parse_mode(name), Ok(mode), "{name}");
+            assert_eq!(mode.name(), name);
+        }
+        let e = parse_mode("spcrr").unwrap_err();
+        assert!(e.contains("spcrr") && e.contains("kawaii, spcr"), "{e}");
+    }
+}
