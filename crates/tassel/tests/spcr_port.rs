@@ -1642,7 +1642,7 @@ fn an_spcr_cloth_recovers_from_a_hitch_nan_and_a_teleport() {
     assert!(sim.frame(&bad, comp, 1.0 / 60.0).is_err());
     let (locals, comp) = animated(&sk, Motion::Sin, 0.7);
     let resets = sim.cloth_state().reset_count();
-    let far = Transform::from_translation(Vec3::new(50.0, 0.0, 0.0));
+    let far = Transform::from_translation(comp.translation + Vec3::new(50.0, 0.0, 0.0));
     let pose = sim.frame(&locals, far, 1.0 / 60.0).unwrap().clone();
     assert_eq!(
         sim.cloth_state().reset_count(),
