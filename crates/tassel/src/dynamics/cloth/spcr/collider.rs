@@ -31,7 +31,43 @@ pub(crate) enum SpcrCollider {
     Other(PlacedCollider),
 }
 
+/// A round collider where a (sub-)iteration sees it: `pos` and `dir` a share `delta` of
+/// the way from its place before the iteration to its place now (SPCR lerps both at
+/// every use), its radius widened by the point's.
+#[derive(Clone, Copy)]
+struct Swept {
+    capsule: bool,
+    radius: f64,
+    height: f64,
+    pos: DVec3,
+    dir: DVec3,
+}
+
 impl SpcrCollider {
+    /// The collider as a contact test sees it at share `delta` of the iteration, for a
+    /// point of radius `extra`; `None` for the shapes SPCR has not.
+    fn swept(&self, delta: f64, extra: f64) -> Option<Swept> {
+        match *self {
+            SpcrCollider::Round {
+                capsule,
+                radius,
+                height,
+                pos,
+                dir,
+                pos_prev,
+                dir_prev,
+                ..
+            } => Some(Swept {
+                capsule,
+                radius: radius + extra,
+                height,
+                pos: lerp(pos_prev, pos, delta),
+                dir: lerp(dir_prev, dir, delta),
+            }),
+            SpcrCollider::Other(_) => None,
+        }
+    }
+
     /// SPCR's place of `col` this frame: (capsule, radius, height, position, direction).
     fn target(col: &PlacedCollider) -> Option<(bool, f64, f64, DVec3, DVec3)> {
         match col.shape {
@@ -148,47 +184,30 @@ fn push_from_sphere(centre: DVec3, radius: f64, p: DVec3) -> DVec3 {
 
 /// `PushoutFromCollider` for a point of radius `extra` (SPCR's points have none).
 pub(super) fn push_point(col: &SpcrCollider, p: DVec3, extra: f64, delta: f64) -> DVec3 {
-    match *col {
-        SpcrCollider::Round {
-            capsule: false,
-            radius,
-            pos,
-            pos_prev,
-            ..
-        } => push_from_sphere(lerp(pos_prev, pos, delta), radius + extra, p),
-        SpcrCollider::Round {
-            capsule: true,
-            radius,
-            height,
-            pos,
-            dir,
-            pos_prev,
-            dir_prev,
-            ..
-        } => {
-            let radius = radius + extra;
-            let axis = lerp(dir_prev, dir, delta);
-            let n = normalized(axis);
-            let base = lerp(pos_prev, pos, delta);
-            let along = n.dot(p - base);
-            if along <= 0.0 {
-                push_from_sphere(base, radius, p)
-            } else if along >= height {
-                push_from_sphere(base + axis, radius, p)
-            } else {
-                let on = base + n * along;
-                let out = p - on;
-                let sq = out.length_squared();
-                if sq > CAPSULE_EPS_SQ && sq < radius * radius {
-                    on + out * radius / sq.sqrt()
-                } else {
-                    p
-                }
-            }
-        }
-        SpcrCollider::Other(c) => {
-            let q = p.as_vec3();
-            d3(c.resolve(q, q, extra as f32))
+    let Some(c) = col.swept(delta, extra) else {
+        let SpcrCollider::Other(c) = col else {
+            return p;
+        };
+        let q = p.as_vec3();
+        return d3(c.resolve(q, q, extra as f32));
+    };
+    if !c.capsule {
+        return push_from_sphere(c.pos, c.radius, p);
+    }
+    let n = normalized(c.dir);
+    let along = n.dot(p - c.pos);
+    if along <= 0.0 {
+        push_from_sphere(c.pos, c.radius, p)
+    } else if along >= c.height {
+        push_from_sphere(c.pos + c.dir, c.radius, p)
+    } else {
+        let on = c.pos + n * along;
+        let out = p - on;
+        let sq = out.length_squared();
+        if sq > CAPSULE_EPS_SQ && sq < c.radius * c.radius {
+            on + out * c.radius / sq.sqrt()
+        } else {
+            p
         }
     }
 }
@@ -217,28 +236,15 @@ pub(super) fn segment_contact(
     extra: f64,
     delta: f64,
 ) -> Option<(DVec3, DVec3, f64)> {
-    let SpcrCollider::Round {
-        capsule,
-        radius,
-        pos,
-        dir,
-        pos_prev,
-        dir_prev,
-        ..
-    } = *col
-    else {
-        return None;
-    };
+    let c = col.swept(delta, extra)?;
     if (p2 - p1).length_squared() == 0.0 {
         return None;
     }
-    let radius = radius + extra;
-    let base = lerp(pos_prev, pos, delta);
-    if !capsule {
+    let (radius, base, axis) = (c.radius, c.pos, c.dir);
+    if !c.capsule {
         let (hit, on_line, on_col) = sphere_segment(base, radius, p1, p2);
         return hit.then_some((on_line, on_col, radius));
     }
-    let axis = lerp(dir_prev, dir, delta);
     for centre in [base, base + axis] {
         let (hit, on_line, on_col) = sphere_segment(centre, radius, p1, p2);
         if hit {
@@ -291,22 +297,9 @@ pub(super) fn surface_contact(
     pull: bool,
     delta: f64,
 ) -> Option<(DVec3, DVec3, f64)> {
-    let SpcrCollider::Round {
-        capsule,
-        radius,
-        pos,
-        dir,
-        pos_prev,
-        dir_prev,
-        ..
-    } = *col
-    else {
-        return None;
-    };
-    let radius = radius + extra;
+    let swept = col.swept(delta, extra)?;
+    let (capsule, radius, col_pos, col_dir) = (swept.capsule, swept.radius, swept.pos, swept.dir);
     let [a, b, c] = tri;
-    let col_pos = lerp(pos_prev, pos, delta);
-    let col_dir = lerp(dir_prev, dir, delta);
     let col_n = safe_normal(col_dir);
     let centre = triangle_centre(tri);
     let to_col = normalized(col_pos - centre);
