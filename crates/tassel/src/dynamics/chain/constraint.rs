@@ -508,13 +508,17 @@ fn check_group(chains: &[super::compile::CompiledChain], group: &ChainGroup) -> 
 
 /// `iterations` XPBD passes over `constraints` for a step of `dt` seconds
 /// (KawaiiPhysics' `AdjustByBoneConstraints`, with the Lagrange multipliers `lambda` reset
-/// first as its update does before each batch of passes). Unit masses.
+/// first as its update does before each batch of passes). Unit masses. Each correction
+/// moves the points by `part` of it: 1 in a step; fixed mode's output step (a part of a
+/// step, `StepInput::part`) moves them that part of the way, so that a part near 0
+/// leaves the last step's points where they are.
 pub(crate) fn solve(
     constraints: &[CompiledConstraint],
     lambda: &mut [f32],
     pos: &mut [Vec3],
     dt: f32,
     iterations: u32,
+    part: f32,
 ) {
     if iterations == 0 {
         return;
@@ -530,7 +534,7 @@ pub(crate) fn solve(
             }
             let alpha = c.compliance / (dt * dt);
             let dl = (len - c.rest - alpha * *l) / (2.0 + alpha);
-            let delta = d / len * dl;
+            let delta = d / len * dl * part;
             pos[a] += delta;
             pos[b] -= delta;
             *l += dl;

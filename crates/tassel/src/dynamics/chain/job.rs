@@ -25,11 +25,16 @@ pub struct ChainState {
     path: CharacterPath,
     pos: Vec<Vec3>,
     prev: Vec<Vec3>,
-    // Deviation from the step's targets after the last and the one-before-last step
-    // (fixed mode interpolates between them).
+    // Deviation from the targets the output pass blends by alpha (equal: the output pass
+    // interpolates between them at the frame's end, which is `dev`).
     dev: Vec<Vec3>,
     dev_before: Vec<Vec3>,
     out: Vec<Vec3>,
+    /// Scratch of fixed mode's output step ([`output_step`]): the previous positions it
+    /// moves (its positions are `out`), and the wind generators it draws from, so that
+    /// the kept state is not touched.
+    keep_prev: Vec<Vec3>,
+    keep_rng: Vec<SplitMix64>,
     targets: Vec<Vec3>,
     prev_targets: Vec<Vec3>,
     step_targets: Vec<Vec3>,
@@ -100,6 +105,8 @@ impl ChainState {
             dev: vec![Vec3::ZERO; n],
             dev_before: vec![Vec3::ZERO; n],
             out: vec![Vec3::ZERO; n],
+            keep_prev: vec![Vec3::ZERO; n],
+            keep_rng: (0..c).map(|ci| chain_rng(rig, ci)).collect(),
             targets: vec![Vec3::ZERO; n],
             prev_targets: vec![Vec3::ZERO; n],
             step_targets: vec![Vec3::ZERO; n],
@@ -631,6 +638,7 @@ fn reset_chain(
             wind_cs: wind_cs(s, component),
             dt: h,
             dt_old: h,
+            part: 1.0,
             fixed: accelerates(s),
             world: None,
             push: &[],
@@ -680,10 +688,39 @@ fn space_step(
     to: Transform,
     base_to: Transform,
 ) -> SpaceIn {
+    let ChainState {
+        pos,
+        prev,
+        last_step_base,
+        ..
+    } = state;
+    carry(
+        rig,
+        ci,
+        pos,
+        prev,
+        &mut last_step_base[ci],
+        from,
+        to,
+        base_to,
+    )
+}
+
+/// [`space_step`] on the points `pos`/`prev` with the base bone's last step transform
+/// `last_base` (fixed mode's output step carries copies).
+#[allow(clippy::too_many_arguments)]
+fn carry(
+    rig: &ChainRig,
+    ci: usize,
+    pos: &mut [Vec3],
+    prev: &mut [Vec3],
+    last_base: &mut Transform,
+    from: Transform,
+    to: Transform,
+    base_to: Transform,
+) -> SpaceIn {
     let chain = &rig.chains[ci];
     let s = &chain.settings;
-    let (pos, prev) = (&mut state.pos, &mut state.prev);
-    let last_base = &mut state.last_step_base[ci];
     let (move_cs, rotate_cs) = motion_cs(&from, &to);
     match s.simulation_space {
         super::SimulationSpace::Component => (move_cs * s.skel_comp_move_scale, rotate_cs, None),
@@ -797,7 +834,8 @@ fn run_chain(
         state.needs_reset[ci] = true;
         state.teleports += 1;
     }
-    if state.needs_reset[ci] {
+    let mut reset = state.needs_reset[ci];
+    if reset {
         reset_chain(rig, ci, state, component, true);
     } else {
         match s.mode {
@@ -842,6 +880,7 @@ fn run_chain(
                         wind_cs: wind_cs(s, component),
                         dt,
                         dt_old: state.dt_old[ci],
+                        part: 1.0,
                         fixed: false,
                         world,
                         push: if forced { &state.forces.push } else { &[] },
@@ -877,8 +916,173 @@ fn run_chain(
     if points.clone().any(|p| !state.pos[p].is_finite()) {
         state.teleports += 1;
         reset_chain(rig, ci, state, component, true);
+        reset = true;
     }
-    output_chain(rig, ci, state, component, level);
+    if s.mode == TimeMode::Fixed {
+        output_step(rig, ci, state, component, level);
+    }
+    output_chain(rig, ci, state, component, level, reset);
+}
+
+/// The share of a fixed step under which the time left over after a frame's steps
+/// counts as none (the tolerance with which [`fixed_steps`] counts them): that frame
+/// ends on its last step.
+pub(crate) const ON_STEP: f32 = 1e-4;
+
+/// Fixed mode's output points of chain `ci` in `out` (issue 63): the chain as it is at
+/// the frame's end. A frame that ends on a step outputs that step's points. Between
+/// steps, the output is the part `a` of one more step that the time left over makes
+/// (the accumulator over the step's length), from the last step's state, on this frame's
+/// targets, colliders, character transform and world, with the external forces of the
+/// last step: velocity, gravity, pull and push each move the points by `a` of what a
+/// step would (`StepInput::part`; a step of `a·h` would give gravity `a²` and the pull
+/// `1 − (1 − k)^a`, which kink the output where steps land: measured rougher at
+/// 144 Hz); contacts, limits and lengths as in a step. Its points go to `out` and
+/// nothing of it is kept (the next frame steps on from the last whole step).
+/// Continuous: `a → 0` gives the last step's points, `a → 1` the next step's. Its wind
+/// draws from a copy of the chain's generator.
+fn output_step(
+    rig: &ChainRig,
+    ci: usize,
+    state: &mut ChainState,
+    component: &Transform,
+    level: Option<&Level>,
+) {
+    let s = &rig.chains[ci].settings;
+    let points = rig.chains[ci].points.clone();
+    state.out[points.clone()].copy_from_slice(&state.pos[points.clone()]);
+    let h = 1.0 / s.target_framerate;
+    let left = state.accumulator[ci];
+    if left <= ON_STEP * h {
+        return;
+    }
+    state.keep_prev[points.clone()].copy_from_slice(&state.prev[points]);
+    let from = state.last_step_component[ci];
+    let mut base = state.last_step_base[ci];
+    let (move_cs, rotate_cs, base) = carry(
+        rig,
+        ci,
+        &mut state.out,
+        &mut state.keep_prev,
+        &mut base,
+        from,
+        *component,
+        state.base_now[ci],
+    );
+    let world = world_for(rig, ci, level, &state.out, &state.targets, &from, component);
+    let input = StepInput {
+        targets: &state.targets,
+        normals: &state.normals,
+        colliders: &state.colliders,
+        bounds: &state.bounds,
+        move_cs,
+        rotate_cs,
+        gravity_cs: gravity_cs(s, component),
+        wind_cs: wind_cs(s, component),
+        dt: h,
+        dt_old: h,
+        part: left / h,
+        fixed: true,
+        world,
+        push: if state.forces.reaches(ci) {
+            &state.forces.push
+        } else {
+            &[]
+        },
+        accel: &state.forces.accel,
+        base,
+    };
+    let mut rng = state.rng[ci];
+    step_chain(
+        rig,
+        ci,
+        &input,
+        &mut state.out,
+        &mut state.keep_prev,
+        &mut rng,
+    );
+}
+
+/// [`output_step`] for bone-constraint group `group` (one clock: its lead chain's):
+/// the group's chains step on together.
+fn output_step_group(
+    rig: &ChainRig,
+    group: &ChainGroup,
+    state: &mut ChainState,
+    component: &Transform,
+    level: Option<&Level>,
+) {
+    let lead = group.chains[0];
+    for &ci in &group.chains {
+        let points = rig.chains[ci].points.clone();
+        state.out[points.clone()].copy_from_slice(&state.pos[points]);
+    }
+    let h = 1.0 / rig.chains[lead].settings.target_framerate;
+    let left = state.accumulator[lead];
+    if left <= ON_STEP * h {
+        return;
+    }
+    let from = state.last_step_component[lead];
+    for &ci in &group.chains {
+        let points = rig.chains[ci].points.clone();
+        state.keep_prev[points.clone()].copy_from_slice(&state.prev[points]);
+        state.world_near[ci] =
+            world_for(rig, ci, level, &state.out, &state.targets, &from, component).is_some();
+    }
+    for &ci in &group.chains {
+        let mut base = state.last_step_base[ci];
+        state.space_in[ci] = carry(
+            rig,
+            ci,
+            &mut state.out,
+            &mut state.keep_prev,
+            &mut base,
+            from,
+            *component,
+            state.base_now[ci],
+        );
+    }
+    state.keep_rng.copy_from_slice(&state.rng);
+    let ChainState {
+        out,
+        keep_prev,
+        keep_rng,
+        lambda,
+        targets,
+        normals,
+        colliders,
+        bounds,
+        world_near,
+        forces,
+        space_in,
+        ..
+    } = &mut *state;
+    let frame = GroupFrame {
+        targets,
+        normals,
+        colliders,
+        bounds,
+        space_in,
+        world_near,
+        forces,
+        level,
+        from,
+        component,
+    };
+    let part = left / h;
+    let input_of = |ci: usize| StepInput {
+        part,
+        ..frame.input(rig, ci, h, h, true, None)
+    };
+    step_group(
+        rig,
+        group.into(),
+        &input_of,
+        out,
+        keep_prev,
+        keep_rng,
+        lambda,
+    );
 }
 
 /// Whether the character's motion this frame crosses chain settings `s`' teleport
@@ -890,25 +1094,36 @@ fn teleported(s: &super::ChainSettings, state: &ChainState, component: &Transfor
         || (s.teleport_rotation > 0.0 && turned > s.teleport_rotation)
 }
 
-/// Chain `ci`'s output: the animated pose plus the (interpolated) deviation, blended by
-/// alpha, with bone lengths restored from the root down and this frame's colliders kept.
+/// Chain `ci`'s output: the animated pose plus the deviation, blended by alpha, with
+/// bone lengths restored from the root down and this frame's colliders kept. `reset`:
+/// the chain started again this frame (from the pose, which may be in a collider).
 fn output_chain(
     rig: &ChainRig,
     ci: usize,
     state: &mut ChainState,
     component: &Transform,
     level: Option<&Level>,
+    reset: bool,
 ) {
     let s = &rig.chains[ci].settings;
     let points = rig.chains[ci].points.clone();
-    // Output: the animated pose plus the (interpolated) deviation, blended by alpha, with
-    // bone lengths restored from the root down.
-    let h = 1.0 / s.target_framerate;
-    let w = if s.mode == TimeMode::Fixed {
-        (state.accumulator[ci] / h).clamp(0.0, 1.0)
-    } else {
-        1.0
-    };
+    let alpha = s.alpha * state.alpha[ci];
+    if s.mode == TimeMode::Fixed {
+        // `out` holds the points at the frame's end ([`output_step`]): kept out of this
+        // frame's colliders and at their bone lengths by the step that put them there
+        // (unless the chain started again from its pose this frame).
+        if alpha == 1.0 && !reset {
+            return;
+        }
+        for p in points.clone() {
+            state.dev[p] = state.out[p] - state.targets[p];
+            state.dev_before[p] = state.dev[p];
+        }
+    }
+    // Output: the animated pose plus the deviation, blended by alpha, with bone lengths
+    // restored from the root down (`dev_before` is `dev`: the lerp at 1 keeps the bits
+    // the frame's old interpolation gave).
+    let w = 1.0;
     // The world, only when geometry is within the chain's reach this frame (one BVH
     // query, as in the steps).
     let world = world_for(
@@ -923,7 +1138,7 @@ fn output_chain(
     .map(|w| w.level);
     for p in points {
         let t = state.targets[p];
-        let dev = state.dev_before[p].lerp(state.dev[p], w) * (s.alpha * state.alpha[ci]);
+        let dev = state.dev_before[p].lerp(state.dev[p], w) * alpha;
         let parent = rig.parent[p];
         state.out[p] = if parent == NONE {
             t
@@ -1180,6 +1395,7 @@ impl<'a> GroupFrame<'a> {
             wind_cs: wind_cs(s, self.component),
             dt,
             dt_old,
+            part: 1.0,
             fixed,
             world: self
                 .level
@@ -1225,7 +1441,6 @@ fn run_fixed(rig: &ChainRig, ci: usize, state: &mut ChainState, dt: f32, level: 
     let h = 1.0 / s.target_framerate;
     let acc_old = state.accumulator[ci];
     let (steps, total, skipped) = fixed_steps(s, acc_old, dt);
-    let points = rig.chains[ci].points.clone();
     for k in 1..=steps {
         let w = step_end(k, h, acc_old, skipped, dt);
         place_step(rig, ci, state, w);
@@ -1262,6 +1477,7 @@ fn run_fixed(rig: &ChainRig, ci: usize, state: &mut ChainState, dt: f32, level: 
             wind_cs: wind_cs(s, &comp_b),
             dt: h,
             dt_old: h,
+            part: 1.0,
             fixed: true,
             world,
             push: if forced { &state.forces.push } else { &[] },
@@ -1277,10 +1493,6 @@ fn run_fixed(rig: &ChainRig, ci: usize, state: &mut ChainState, dt: f32, level: 
             &mut state.rng[ci],
         );
         state.last_step_component[ci] = comp_b;
-        for p in points.clone() {
-            state.dev_before[p] = state.dev[p];
-            state.dev[p] = state.pos[p] - state.step_targets[p];
-        }
     }
     state.accumulator[ci] = (total - steps as f32 * h).max(0.0);
 }
@@ -1395,9 +1607,13 @@ fn run_group(
     if group.chains.iter().any(|&ci| bad(ci)) {
         state.teleports += 1;
         reset_group(rig, group, state, component);
+        reset = true;
+    }
+    if s.mode == TimeMode::Fixed {
+        output_step_group(rig, group, state, component, level);
     }
     for &ci in &group.chains {
-        output_chain(rig, ci, state, component, level);
+        output_chain(rig, ci, state, component, level, reset);
     }
 }
 
@@ -1434,6 +1650,7 @@ fn reset_group(rig: &ChainRig, group: &ChainGroup, state: &mut ChainState, compo
                 wind_cs: wind_cs(s, component),
                 dt: h,
                 dt_old: h,
+                part: 1.0,
                 fixed,
                 world: None,
                 push: &[],
@@ -1523,6 +1740,7 @@ fn run_fixed_group(
                     wind_cs: wind_cs(s, &comp_b),
                     dt: h,
                     dt_old: h,
+                    part: 1.0,
                     fixed: true,
                     world: level.filter(|_| world_near[ci]).map(|level| WorldContact {
                         level,
@@ -1542,10 +1760,6 @@ fn run_fixed_group(
         }
         for &ci in &group.chains {
             state.last_step_component[ci] = comp_b;
-            for p in rig.chains[ci].points.clone() {
-                state.dev_before[p] = state.dev[p];
-                state.dev[p] = state.pos[p] - state.step_targets[p];
-            }
         }
     }
     for &ci in &group.chains {

@@ -29,6 +29,12 @@ pub(crate) struct StepInput<'a> {
     /// Step length and the previous step's length, seconds.
     pub dt: f32,
     pub dt_old: f32,
+    /// The part of the step taken: 1, but in fixed mode's output step (the time left
+    /// over after the frame's steps over the step's length), which moves the points by
+    /// that part of each of the step's terms (velocity, gravity, pull, push; the
+    /// character's motion is its own, from the last step to the frame) and of each bone
+    /// constraint's correction.
+    pub part: f32,
     /// True in fixed mode (gravity as an acceleration).
     pub fixed: bool,
     /// The world, when the chain collides with it and geometry is near.
@@ -47,6 +53,8 @@ pub(crate) struct StepInput<'a> {
 /// What one step of a chain uses for every point.
 struct ChainStep {
     exponent: f32,
+    /// The time the points move: `dt · part`.
+    moved: f32,
     gravity_step: Vec3,
     wind_on: bool,
     /// The wind's direction noise, radians (0: none).
@@ -57,7 +65,8 @@ impl ChainStep {
     fn of(s: &ChainSettings, input: &StepInput) -> Self {
         Self {
             exponent: s.target_framerate * input.dt,
-            gravity_step: gravity_step(s, input.gravity_cs, input.dt, input.fixed),
+            moved: input.dt * input.part,
+            gravity_step: gravity_step(s, input.gravity_cs, input.dt, input.fixed) * input.part,
             wind_on: s.wind.speed > 0.0 && input.wind_cs != Vec3::ZERO,
             wind_noise: s.wind.direction_noise_angle.to_radians(),
         }
@@ -102,7 +111,7 @@ fn advance(
     if forced {
         velocity += input.accel[p] * input.dt;
     }
-    let mut x = pos[p] + velocity * input.dt;
+    let mut x = pos[p] + velocity * k.moved;
 
     // Inertia: follow the character's translation and rotation only partly.
     x += input.move_cs * (1.0 - rig.wd_location[p]);
@@ -113,12 +122,12 @@ fn advance(
     x += (input.rotate_cs * before - prev[p]) * (1.0 - rig.wd_rotation[p]);
     x += k.gravity_step;
     if forced {
-        x += input.push[p] * input.dt;
+        x += input.push[p] * k.moved;
     }
 
     // Pull toward the animated pose, relative to the simulated parent.
     let base = pos[pp] + (t[p] - t[pp]);
-    x += (base - x) * pull(rig.stiffness[p], k.exponent);
+    x += (base - x) * (pull(rig.stiffness[p], k.exponent) * input.part);
     x
 }
 
@@ -332,10 +341,11 @@ pub(crate) fn step_group<'a>(
             );
         }
     }
-    let dt = input_of(group.chains[0]).dt;
+    let lead = input_of(group.chains[0]);
+    let (dt, part) = (lead.dt, lead.part);
     let list = &rig.constraints.list[group.constraints.clone()];
     let lambda = &mut lambda[group.constraints];
-    solve(list, lambda, pos, dt, rig.constraints.before);
+    solve(list, lambda, pos, dt, rig.constraints.before, part);
     for &ci in group.chains {
         let chain = &rig.chains[ci];
         let input = input_of(ci);
@@ -352,7 +362,7 @@ pub(crate) fn step_group<'a>(
             pos[p] = contact.resolve(pos[p]);
         }
     }
-    solve(list, lambda, pos, dt, rig.constraints.after);
+    solve(list, lambda, pos, dt, rig.constraints.after, part);
     for &ci in group.chains {
         let chain = &rig.chains[ci];
         let input = input_of(ci);

@@ -9,7 +9,9 @@
 use super::pack::{Pack, Scratch};
 use super::step::{output_lanes, step_lanes, Ahead, LaneShape, LaneStep, NO_AHEAD};
 use crate::dynamics::chain::compile::{ChainRig, NONE, VIRTUAL};
-use crate::dynamics::chain::job::{gravity_cs, motion_cs, place_colliders, slerp_angle, wind_cs};
+use crate::dynamics::chain::job::{
+    gravity_cs, motion_cs, place_colliders, slerp_angle, wind_cs, ON_STEP,
+};
 use crate::dynamics::chain::step::gravity_step;
 use crate::dynamics::chain::{ChainSettings, ClassicGravity, PlanarAxis, TimeMode};
 use crate::error::{Error, Result};
@@ -737,16 +739,30 @@ impl Ctx<'_> {
             }
             self.reset_chain::<T>(ci, pack, s, bad);
         }
-        let w = match set.mode {
-            TimeMode::Fixed => {
-                (pack.accumulator[ci] / F::splat(1.0 / set.target_framerate)).clamp01()
+        // The lanes the output pass writes: every live one, but in fixed mode with an
+        // alpha of 1 only those that started again this frame (as the chain job's
+        // `output_chain`).
+        let mut pass = live;
+        if set.mode == TimeMode::Fixed {
+            // `out` holds the points at the frame's end, as the chain job's `output_step`
+            // puts them there; the output pass blends them by alpha.
+            self.output_step::<T>(ci, pack, s, live);
+            if set.alpha == 1.0 {
+                pass = reset.or(bad);
+                if !pass.any() {
+                    return;
+                }
             }
-            TimeMode::Classic | TimeMode::Kawaii => F::splat(1.0),
-        };
+            for p in points {
+                let d = pack.out[p] - s.targets[p];
+                pack.dev[p] = d;
+                pack.dev_before[p] = d;
+            }
+        }
         output_lanes::<T>(
             rig,
             ci,
-            w,
+            F::splat(1.0),
             &s.targets,
             &pack.dev_before,
             &pack.dev,
@@ -755,7 +771,83 @@ impl Ctx<'_> {
             &s.bounds,
             self.shapes,
             &mut pack.out,
-            live,
+            pass,
+            &mut s.near,
+        );
+    }
+
+    /// The chain job's `output_step` for the `live` lanes: each lane's points at the
+    /// frame's end in `out`, its last step's, or the share of one more step its time
+    /// left over makes, on the frame's targets and colliders, not kept.
+    #[inline(always)]
+    pub(crate) fn output_step<T: Lane>(
+        &self,
+        ci: usize,
+        pack: &mut Pack,
+        s: &mut Scratch,
+        live: M,
+    ) {
+        let rig = self.rig;
+        let set = &rig.chains[ci].settings;
+        let points = rig.chains[ci].points.clone();
+        pack.out[points.clone()].copy_from_slice(&pack.pos[points.clone()]);
+        let h = 1.0 / set.target_framerate;
+        let left = pack.accumulator[ci];
+        let on = M::from_bools(std::array::from_fn(|l| {
+            live.0[l] != 0 && left.0[l] > ON_STEP * h
+        }));
+        if !on.any() {
+            return;
+        }
+        s.keep_prev[points.clone()].copy_from_slice(&pack.prev[points]);
+        // Each lane's part of a step, and gravity's part of it.
+        let part = F(std::array::from_fn(|l| {
+            if on.0[l] != 0 {
+                left.0[l] / h
+            } else {
+                1.0
+            }
+        }));
+        let mut mo = motion(
+            set,
+            Some(&pack.last_step_component[ci]),
+            &s.component,
+            h,
+            true,
+            on,
+            pack.shared,
+        );
+        for l in 0..LANES {
+            if on.0[l] != 0 {
+                mo.gravity_step.set(l, mo.gravity_step.get(l) * part.0[l]);
+            }
+        }
+        let input = LaneStep {
+            targets: &s.targets,
+            normals: &s.normals,
+            colliders: &s.colliders,
+            stride: pack.collider_stride(),
+            bounds: &s.bounds,
+            shapes: self.shapes,
+            move_cs: mo.move_cs,
+            rotate_cs: mo.rotate_cs,
+            gravity_step: mo.gravity_step,
+            wind_cs: mo.wind_cs,
+            wind_on: mo.wind_on,
+            dt: h,
+            dt_old: F::splat(h),
+            part: Some(part),
+            active: on,
+            ahead: NO_AHEAD,
+        };
+        let mut rng = pack.rng[ci];
+        step_lanes::<T>(
+            rig,
+            ci,
+            &input,
+            &mut pack.out,
+            &mut s.keep_prev,
+            &mut rng,
             &mut s.near,
         );
     }
@@ -808,6 +900,7 @@ impl Ctx<'_> {
                     wind_on: mo.wind_on,
                     dt: h,
                     dt_old: F::splat(h),
+                    part: None,
                     active: m,
                     ahead: NO_AHEAD,
                 };
@@ -871,6 +964,7 @@ impl Ctx<'_> {
                 wind_on: mo.wind_on,
                 dt,
                 dt_old: pack.dt_old[ci],
+                part: None,
                 active: run,
                 ahead,
             };
@@ -1033,6 +1127,7 @@ impl Ctx<'_> {
                 wind_on: mo.wind_on,
                 dt: h,
                 dt_old: F::splat(h),
+                part: None,
                 active,
                 ahead,
             };
@@ -1047,11 +1142,6 @@ impl Ctx<'_> {
             );
             pack.last_step_component[ci] =
                 Trs::select(active, &comp_b, &pack.last_step_component[ci]);
-            for p in chain.points.clone() {
-                let d = pack.pos[p] - s.step_targets[p];
-                pack.dev_before[p] = V3::select(active, pack.dev[p], pack.dev_before[p]);
-                pack.dev[p] = V3::select(active, d, pack.dev[p]);
-            }
         }
         let mut acc = pack.accumulator[ci];
         for l in 0..LANES {

@@ -268,6 +268,8 @@ pub(crate) struct Scratch {
     pub(crate) new_rotations: Vec<(Q, M)>,
     /// A point's broad phase: the lanes each member of its chain's collider list may touch.
     pub(crate) near: Vec<M>,
+    /// The previous positions fixed mode's output step moves (not the kept ones).
+    pub(crate) keep_prev: Vec<V3>,
     /// The last motion computed.
     pub(crate) motion: MotionMemo,
     /// Each lane's motion since the last frame: how far it moved and how far it turned
@@ -306,6 +308,7 @@ impl Scratch {
                     .max()
                     .unwrap_or(0)
             ],
+            keep_prev: vec![zero; n],
             motion: MotionMemo::new(),
             jump: [(0.0, 0.0); LANES],
         }

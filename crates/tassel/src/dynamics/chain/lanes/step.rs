@@ -89,6 +89,9 @@ pub(crate) struct LaneStep<'a> {
     pub wind_on: M,
     pub dt: f32,
     pub dt_old: F,
+    /// The part of the step each lane takes (the scalar step's `StepInput::part`): 1 but
+    /// in fixed mode's output step; `None`: 1 in every lane.
+    pub part: Option<F>,
     /// The lanes that take this step; the others are left as they are.
     pub active: M,
     /// The next lane group's state, asked into the caches point by point as this one
@@ -294,7 +297,11 @@ pub(crate) fn step_lanes<T: Lane>(
     let s = &chain.settings;
     let exponent = s.target_framerate * input.dt;
     let active = <T::M as Mask>::of(input.active);
-    let dt = T::splat(input.dt);
+    // The time a lane's points move this step: `dt` times its part.
+    let (dt, part) = match input.part {
+        None => (T::splat(input.dt), None),
+        Some(a) => (T::of(F(a.0.map(|a| input.dt * a))), Some(T::of(a))),
+    };
     let list = &chain.colliders;
     let dt_old = T::of(input.dt_old);
     let has_velocity = dt_old.gt(T::splat(0.0));
@@ -343,7 +350,11 @@ pub(crate) fn step_lanes<T: Lane>(
         let parent_pos = V3::<T>::of(pos[pp]);
         let (tp, tpp) = (V3::<T>::of(input.targets[p]), V3::of(input.targets[pp]));
         let base = parent_pos + (tp - tpp);
-        x = x + (base - x) * T::splat(pull(rig.stiffness[p], exponent));
+        let mut pulled = T::splat(pull(rig.stiffness[p], exponent));
+        if let Some(a) = part {
+            pulled = pulled * a;
+        }
+        x = x + (base - x) * pulled;
 
         let r = rig.radius[p];
         let anim_dir = tp - tpp;
@@ -414,8 +425,8 @@ pub(crate) fn step_lanes<T: Lane>(
 
 /// The output pass of chain `ci` (as the chain job's): the animated pose plus the
 /// deviation interpolated by `w` and scaled by the chain's alpha, bone lengths restored
-/// from the root down, kept out of the colliders; for the `live` lanes (the others get
-/// the arithmetic, not the narrow phase).
+/// from the root down, kept out of the colliders; for the `live` lanes (the others keep
+/// their `out`, and get the arithmetic, not the narrow phase).
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn output_lanes<T: Lane>(
@@ -444,7 +455,7 @@ pub(crate) fn output_lanes<T: Lane>(
         let d = V3::<T>::of(dev_before[p]).lerp(V3::of(dev[p]), w) * alpha;
         let parent = rig.parent[p];
         if parent == NONE {
-            out[p] = t.f();
+            out[p] = V3::select(live_t, t, V3::of(out[p])).f();
             continue;
         }
         let pp = parent as usize;
@@ -482,7 +493,7 @@ pub(crate) fn output_lanes<T: Lane>(
                 break;
             }
         }
-        out[p] = x.f();
+        out[p] = V3::select(live_t, x, V3::of(out[p])).f();
     }
 }
 
