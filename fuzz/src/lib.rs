@@ -359,7 +359,17 @@ pub fn simulation(data: &[u8]) {
         ..RigSettings::default()
     };
     match u.int_in_range(0..=4).unwrap_or(0) {
-        0 => rig.chains = full.chains.clone(),
+        0 => {
+            rig.chains = full.chains.clone();
+            // A third of the chain inputs put points between their bones.
+            if u.ratio(1, 3).unwrap_or(false) {
+                for c in &mut rig.chains {
+                    c.bone_subdivision_count = u.int_in_range(0..=10).unwrap_or(1);
+                    c.bone_subdivision_collision_only = u.arbitrary().unwrap_or(true);
+                    c.bone_subdivision_densify_by_radius = u.arbitrary().unwrap_or(false);
+                }
+            }
+        }
         1 => rig.springs = full.springs.clone(),
         2 => {
             rig.cloths = full.cloths.clone();

@@ -35,13 +35,16 @@ pub(crate) struct CompiledChain {
 
 impl CompiledChain {
     /// Whether the chain's settings ask for what only the scalar step does: a simulation
-    /// space other than the character's, a move scale, a noisy wind, `kawaii` mode.
+    /// space other than the character's, a move scale, a noisy wind, `kawaii` mode, bone
+    /// subdivision.
     pub(crate) fn scalar_only(&self) -> bool {
         let s = &self.settings;
         s.simulation_space != super::SimulationSpace::Component
             || s.skel_comp_move_scale != glam::Vec3::ONE
             || s.wind.direction_noise_angle > 0.0
             || s.mode == super::TimeMode::Kawaii
+            || s.bone_subdivision_count > 0
+            || s.bone_subdivision_densify_by_radius
     }
 }
 
@@ -54,6 +57,17 @@ pub struct ChainRig {
     // Per point (structure of arrays), chains one after another, parents before children.
     pub(crate) joint: Vec<u16>,
     pub(crate) parent: Vec<u32>,
+    /// Per point: its nearest ancestor point that is not a point between bones (NONE for
+    /// a root); for a point between bones, the bone it starts from.
+    pub(crate) real_parent: Vec<u32>,
+    /// Per point between bones (`bone_subdivision_count`): its place on its segment,
+    /// 0..1 exclusive (0: not such a point), and the segment's end point.
+    pub(crate) inter_alpha: Vec<f32>,
+    pub(crate) inter_end: Vec<u32>,
+    /// Per point: a point between bones that only collides (carried on its segment).
+    pub(crate) carried: Vec<bool>,
+    /// Some chain has points between bones.
+    pub(crate) subdivided: bool,
     pub(crate) chain_of: Vec<u16>,
     pub(crate) dummy_length: Vec<f32>,
     pub(crate) damping: Vec<f32>,
@@ -86,6 +100,81 @@ pub struct ChainRig {
 }
 
 impl ChainRig {
+    /// Appends a point: joint `joint` (or [`VIRTUAL`]), parent point `parent`, nearest
+    /// real ancestor `real_parent`, virtual tip length `dummy_length` (0: none).
+    fn push_point(&mut self, joint: u16, parent: u32, real_parent: u32, dummy_length: f32) {
+        self.joint.push(joint);
+        self.parent.push(parent);
+        self.real_parent.push(real_parent);
+        self.dummy_length.push(dummy_length);
+        self.inter_alpha.push(0.0);
+        self.inter_end.push(NONE);
+        self.carried.push(false);
+    }
+
+    /// The points between bone point `from` and the point about to follow it, `length`
+    /// apart at rest (KawaiiPhysics 1.21's `InsertInterBoneDummyBonesCore`):
+    /// `bone_subdivision_count` of them, more where `bone_subdivision_densify_by_radius`
+    /// asks, none on a segment of no length. Returns the last point (the next one's
+    /// parent) and how many were put.
+    fn subdivide(
+        &mut self,
+        s: &ChainSettings,
+        from: u32,
+        length: f32,
+        start: usize,
+        rest_dist: &mut Vec<f32>,
+    ) -> (u32, usize) {
+        // KawaiiPhysics' KINDA_SMALL_NUMBER (1e-4 cm), in metres.
+        const SMALL: f32 = 1e-6;
+        if length <= SMALL {
+            return (from, 0);
+        }
+        let mut n = s.bone_subdivision_count.min(10) as usize;
+        if s.bone_subdivision_densify_by_radius {
+            // The radius curve's smallest value over the chain: its ends and its keys
+            // within [0, 1] (KawaiiPhysics' conservative estimate).
+            let curve = &s.curves.radius;
+            let smallest = curve
+                .keys
+                .iter()
+                .filter(|k| (0.0..=1.0).contains(&k[0]))
+                .map(|k| k[1])
+                .fold(curve.eval(0.0).min(curve.eval(1.0)), f32::min);
+            let radius = s.radius * smallest.max(0.0);
+            if radius > SMALL {
+                let cover = ((length / (2.0 * radius)).ceil() as i64 - 1).max(0) as usize;
+                n = n.max(cover);
+            }
+        }
+        let n = n.min(50);
+        let mut parent = from;
+        for k in 0..n {
+            let alpha = (k + 1) as f32 / (n + 1) as f32;
+            let idx = self.joint.len() as u32;
+            self.push_point(VIRTUAL, parent, from, 0.0);
+            self.inter_alpha[idx as usize] = alpha;
+            self.carried[idx as usize] = s.bone_subdivision_collision_only;
+            rest_dist.push(rest_dist[parent as usize - start] + length / (n + 1) as f32);
+            parent = idx;
+        }
+        (parent, n)
+    }
+
+    /// Point `end` ends the segment whose points [`Self::subdivide`] just put.
+    fn end_segment(&mut self, end: u32) {
+        let mut p = self.parent[end as usize];
+        while p != NONE && self.inter_alpha[p as usize] > 0.0 {
+            self.inter_end[p as usize] = end;
+            p = self.parent[p as usize];
+        }
+    }
+
+    /// Whether point `p` lies between bones (`bone_subdivision_count`).
+    pub(crate) fn is_inter(&self, p: usize) -> bool {
+        self.inter_alpha[p] > 0.0
+    }
+
     /// The axis, in the parent joint's space, that point `p`'s planar constraint keeps
     /// its bone perpendicular to (its chain's `planar_constraint`), or `None` when its
     /// chain has none (then no step reads a normal of its).
@@ -119,6 +208,11 @@ impl ChainRig {
             colliders: Vec::new(),
             joint: Vec::new(),
             parent: Vec::new(),
+            real_parent: Vec::new(),
+            inter_alpha: Vec::new(),
+            inter_end: Vec::new(),
+            carried: Vec::new(),
+            subdivided: false,
             chain_of: Vec::new(),
             dummy_length: Vec::new(),
             damping: Vec::new(),
@@ -174,7 +268,7 @@ impl ChainRig {
                     )));
                 }
                 owner[j] = Some(ci);
-                let parent = if j == root {
+                let real_parent = if j == root {
                     NONE
                 } else {
                     skeleton
@@ -182,19 +276,28 @@ impl ChainRig {
                         .and_then(|p| point_of.get(&p).copied())
                         .unwrap_or(NONE)
                 };
+                let mut parent = real_parent;
+                let mut d = 0.0;
+                if real_parent != NONE {
+                    let pj = out.joint[real_parent as usize] as usize;
+                    let length =
+                        (rest.models[j].translation - rest.models[pj].translation).length();
+                    parent = out
+                        .subdivide(settings, real_parent, length, start, &mut rest_dist)
+                        .0;
+                    // KawaiiPhysics 1.21 counts a bone's whole length again after the
+                    // points before it (its `CalcBoneLength`); `kawaii` mode does too.
+                    let from = match settings.mode {
+                        super::TimeMode::Kawaii => parent,
+                        _ => real_parent,
+                    };
+                    d = rest_dist[from as usize - start] + length;
+                }
                 let idx = out.joint.len() as u32;
                 point_of.insert(j, idx);
-                out.joint.push(j as u16);
-                out.parent.push(parent);
-                out.dummy_length.push(0.0);
-                let d = if parent == NONE {
-                    0.0
-                } else {
-                    let pj = out.joint[parent as usize] as usize;
-                    rest_dist[parent as usize - start]
-                        + (rest.models[j].translation - rest.models[pj].translation).length()
-                };
+                out.push_point(j as u16, parent, real_parent, 0.0);
                 rest_dist.push(d);
+                out.end_segment(idx);
             }
             if out.joint.len() - start < 2 && settings.dummy_bone_length <= 0.0 {
                 return Err(Error::InvalidParameter(format!(
@@ -206,12 +309,18 @@ impl ChainRig {
             if settings.dummy_bone_length > 0.0 {
                 let real_end = out.joint.len();
                 for p in start..real_end {
-                    let is_leaf = !(start..real_end).any(|c| out.parent[c] == p as u32);
+                    let is_leaf = out.inter_alpha[p] == 0.0
+                        && !(start..real_end).any(|c| out.real_parent[c] == p as u32);
                     if is_leaf {
-                        out.joint.push(VIRTUAL);
-                        out.parent.push(p as u32);
-                        out.dummy_length.push(settings.dummy_bone_length);
-                        rest_dist.push(rest_dist[p - start] + settings.dummy_bone_length);
+                        let length = settings.dummy_bone_length;
+                        let (parent, n) =
+                            out.subdivide(settings, p as u32, length, start, &mut rest_dist);
+                        let tip = out.joint.len() as u32;
+                        out.push_point(VIRTUAL, parent, p as u32, length);
+                        // After points, the tip's own segment (as 1.21 counts it too).
+                        rest_dist
+                            .push(rest_dist[parent as usize - start] + length / (n + 1) as f32);
+                        out.end_segment(tip);
                     }
                 }
             }
@@ -263,6 +372,7 @@ impl ChainRig {
                 base,
             });
         }
+        out.subdivided = out.inter_alpha.iter().any(|&a| a > 0.0);
         // Rotators, in joint order so parents are written before children.
         let mut rot: Vec<(u16, u32, Vec<u32>)> = Vec::new();
         for p in 0..out.joint.len() {
@@ -271,6 +381,11 @@ impl ChainRig {
                 continue;
             }
             let pj = out.joint[parent as usize];
+            if pj == VIRTUAL {
+                // A point between bones turns no bone (its real bone turns toward the
+                // first point after it).
+                continue;
+            }
             match rot.iter_mut().find(|r| r.1 == parent) {
                 Some(r) => r.2.push(p as u32),
                 None => rot.push((pj, parent, vec![p as u32])),
@@ -369,6 +484,8 @@ impl ChainRig {
         let table = PointTable {
             joint: &self.joint,
             parent: &self.parent,
+            real_parent: &self.real_parent,
+            dummy_length: &self.dummy_length,
             chain_of: &self.chain_of,
             rest: &rest,
         };

@@ -333,6 +333,10 @@ pub(crate) struct Constraints {
 pub(crate) struct PointTable<'a> {
     pub joint: &'a [u16],
     pub parent: &'a [u32],
+    /// The nearest ancestor point that is not a point between bones.
+    pub real_parent: &'a [u32],
+    /// Virtual tips' lengths (0: not a tip).
+    pub dummy_length: &'a [f32],
     pub chain_of: &'a [u16],
     /// Rest-pose position of every point (virtual tips included).
     pub rest: &'a [Vec3],
@@ -370,10 +374,11 @@ pub(crate) fn compile(
     };
     let dummy_child = |p: usize| {
         let chain = &chains[points.chain_of[p] as usize];
-        chain
-            .points
-            .clone()
-            .find(|&c| points.parent[c] == p as u32 && points.joint[c] == VIRTUAL)
+        chain.points.clone().find(|&c| {
+            points.real_parent[c] == p as u32
+                && points.joint[c] == VIRTUAL
+                && points.dummy_length[c] > 0.0
+        })
     };
     let mut list = Vec::new();
     let mut dummies = Vec::new();

@@ -599,7 +599,7 @@ impl Forces {
         for p in 0..rig.point_count() {
             let mut j = rig.joint[p];
             if j == VIRTUAL {
-                j = rig.joint[rig.parent[p] as usize];
+                j = rig.joint[rig.real_parent[p] as usize];
             }
             self.bone[p] = models[j as usize];
         }

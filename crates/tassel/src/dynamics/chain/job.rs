@@ -562,8 +562,10 @@ pub(crate) fn gather_targets(
 ) {
     for (p, axis) in rig.points_and_planar_axes() {
         let j = rig.joint[p];
-        let parent = rig.parent[p];
-        targets[p] = if j == VIRTUAL {
+        let parent = rig.real_parent[p];
+        if rig.is_inter(p) {
+            // Placed below, once both ends are.
+        } else if j == VIRTUAL {
             let leaf = rig.joint[parent as usize] as usize;
             let from = sk.parent(leaf).map(|q| models[q].translation);
             let dir = match from {
@@ -573,15 +575,25 @@ pub(crate) fn gather_targets(
                 ),
                 None => models[leaf].rotation * Vec3::Y,
             };
-            models[leaf].translation + dir * rig.dummy_length[p]
+            targets[p] = models[leaf].translation + dir * rig.dummy_length[p];
         } else {
-            models[j as usize].translation
-        };
+            targets[p] = models[j as usize].translation;
+        }
         // The normals only where a planar constraint reads them (the others keep what
         // they hold, never read).
         if let (true, Some(axis)) = (parent != NONE, axis) {
             let pj = rig.joint[parent as usize] as usize;
             normals[p] = models[pj].rotation * axis;
+        }
+    }
+    // Points between bones: on their segment between its two ends (KawaiiPhysics 1.21's
+    // `UpdateInterBoneDummyPose`, a second pass).
+    if rig.subdivided {
+        for p in 0..rig.point_count() {
+            if rig.is_inter(p) {
+                let (a, b) = (rig.real_parent[p] as usize, rig.inter_end[p] as usize);
+                targets[p] = targets[a].lerp(targets[b], rig.inter_alpha[p]);
+            }
         }
     }
     place_colliders(rig, models, colliders);

@@ -229,6 +229,37 @@ pub struct ChainSettings {
     /// all; `[1, 0, 1]`: a jump does not lift the hair).
     #[serde(skip_serializing_if = "is_one")]
     pub skel_comp_move_scale: Vec3,
+    /// Points put between each bone and its child, and between a leaf and its virtual tip
+    /// (KawaiiPhysics 1.21's `BoneSubdivisionCount`, 0..=10; 0: none): evenly spaced on
+    /// the segment, so that colliders meet the bone along its length, not only at its
+    /// ends. Chains with them step per character (not in lanes).
+    #[serde(skip_serializing_if = "is_zero_u32")]
+    pub bone_subdivision_count: u32,
+    /// The points between bones only collide (KawaiiPhysics' `bBoneSubdivisionCollisionOnly`,
+    /// default true): they are placed on the segment between the simulated bone and its
+    /// simulated child each step, pushed by the colliders, and the child hangs from them;
+    /// a chain that touches nothing moves as without them. False: they are simulated as
+    /// bones of their own (inertia, stiffness, gravity).
+    #[serde(skip_serializing_if = "is_true")]
+    pub bone_subdivision_collision_only: bool,
+    /// Put more points where a segment is longer than the points' diameter, so that their
+    /// spheres touch along it (KawaiiPhysics' `bBoneSubdivisionDensifyByRadius`: at least
+    /// `ceil(length / (2 · radius)) − 1` on a segment, the radius the smallest the radius
+    /// curve gives over the chain, at most 50 a segment).
+    #[serde(skip_serializing_if = "is_false")]
+    pub bone_subdivision_densify_by_radius: bool,
+}
+
+fn is_zero_u32(n: &u32) -> bool {
+    *n == 0
+}
+
+fn is_true(b: &bool) -> bool {
+    *b
+}
+
+fn is_false(b: &bool) -> bool {
+    !*b
 }
 
 impl Default for ChainSettings {
@@ -264,6 +295,9 @@ impl Default for ChainSettings {
             simulation_space: SimulationSpace::Component,
             simulation_base_bone: String::new(),
             skel_comp_move_scale: Vec3::ONE,
+            bone_subdivision_count: 0,
+            bone_subdivision_collision_only: true,
+            bone_subdivision_densify_by_radius: false,
         }
     }
 }
@@ -322,6 +356,12 @@ impl ChainSettings {
             return bad(format!(
                 "max_steps_per_frame is {}; it must be 1..={max_steps}",
                 self.max_steps_per_frame
+            ));
+        }
+        if self.bone_subdivision_count > 10 {
+            return bad(format!(
+                "bone_subdivision_count is {}; it must be 0..=10",
+                self.bone_subdivision_count
             ));
         }
         if !(1..=16).contains(&self.max_substeps) {

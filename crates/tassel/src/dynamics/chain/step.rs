@@ -2,7 +2,7 @@
 
 use super::compile::{ChainRig, NONE};
 use super::constraint::{solve, ChainGroup};
-use super::settings::{ChainSettings, ClassicGravity, PlanarAxis};
+use super::settings::{ChainSettings, ClassicGravity, PlanarAxis, TimeMode};
 use crate::collide::{NearSet, PlacedCollider};
 use crate::math::normalize_or;
 use crate::rng::SplitMix64;
@@ -278,7 +278,29 @@ pub(crate) fn step_chain(
             continue;
         }
         let pp = parent as usize;
-        let x = advance(rig, s, &k, input, p, pp, pos, prev, rng);
+        let x = if rig.carried[p] {
+            // A point between bones that only collides: on its segment, its share of the
+            // bone's length from the bone's final place toward where the bone's child
+            // steps to. That child steps first, from its bone, as it would without the
+            // points, and is put at the bone's length (a chain that touches nothing moves
+            // as without them; a child stepped nearer than the points would fold the
+            // segment back on itself).
+            let (a, b) = (rig.real_parent[p] as usize, rig.inter_end[p] as usize);
+            let anim = t[b] - t[a];
+            let dir = |pos: &[Vec3]| normalize_or(pos[b] - pos[a], normalize_or(anim, Vec3::Y));
+            if pp == a {
+                let x = advance(rig, s, &k, input, b, a, pos, prev, rng);
+                pos[b] = x;
+                pos[b] = pos[a] + dir(pos) * anim.length();
+            }
+            prev[p] = pos[p];
+            pos[a] + dir(pos) * (rig.inter_alpha[p] * anim.length())
+        } else if rig.carried[pp] {
+            // Stepped with the first point of its segment, above.
+            pos[p]
+        } else {
+            advance(rig, s, &k, input, p, pp, pos, prev, rng)
+        };
         let length = (t[p] - t[pp]).length();
         let contact = Contact::of(rig, &chain.colliders, input, p, pos[pp], length, x, prev[p]);
         let x = contact.resolve(x);
@@ -328,17 +350,52 @@ pub(crate) fn step_group<'a>(
                 prev[p] = input.targets[p];
                 continue;
             }
+            if rig.carried[p] {
+                // Placed on its segment once both ends have stepped, below.
+                continue;
+            }
+            // A bone after points that only collide pulls toward its bone, as without the
+            // points; `kawaii` mode pulls toward the last point's place before this step,
+            // as KawaiiPhysics 1.21 does (its `Simulate` reads the parent in the array,
+            // which `SimulateOnce` has not placed yet).
+            let from = if rig.carried[parent as usize] && chain.settings.mode != TimeMode::Kawaii {
+                rig.real_parent[p]
+            } else {
+                parent
+            };
             pos[p] = advance(
                 rig,
                 &chain.settings,
                 &k,
                 &input,
                 p,
-                parent as usize,
+                from as usize,
                 pos,
                 prev,
                 &mut rngs[ci],
             );
+        }
+        // Points between bones that only collide: on their segment between its ends'
+        // new places (1.21's `SimulateOnce` after every bone's `Simulate`).
+        // (`fixed` and `classic`: at their share of the bone's length from the bone, as
+        // the per-point step puts them.)
+        if rig.subdivided {
+            let kawaii = chain.settings.mode == TimeMode::Kawaii;
+            let t = input.targets;
+            for p in chain.points.clone() {
+                if rig.carried[p] {
+                    let (a, b) = (rig.real_parent[p] as usize, rig.inter_end[p] as usize);
+                    let alpha = rig.inter_alpha[p];
+                    prev[p] = pos[p];
+                    pos[p] = if kawaii {
+                        pos[a].lerp(pos[b], alpha)
+                    } else {
+                        let anim = t[b] - t[a];
+                        let dir = normalize_or(pos[b] - pos[a], normalize_or(anim, Vec3::Y));
+                        pos[a] + dir * (alpha * anim.length())
+                    };
+                }
+            }
         }
     }
     let lead = input_of(group.chains[0]);

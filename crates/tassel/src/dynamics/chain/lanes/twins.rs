@@ -270,6 +270,21 @@ fn one_chain(rig: &ChainRig, ci: usize) -> ChainRig {
                 }
             })
             .collect(),
+        // Twin chains have no points between bones (`CompiledChain::scalar_only`).
+        real_parent: rig.real_parent[range.clone()]
+            .iter()
+            .map(|&p| {
+                if p == NONE {
+                    NONE
+                } else {
+                    p - range.start as u32
+                }
+            })
+            .collect(),
+        inter_alpha: vec![0.0; range.len()],
+        inter_end: vec![NONE; range.len()],
+        carried: vec![false; range.len()],
+        subdivided: false,
         chain_of: vec![0; range.len()],
         dummy_length: slice(&rig.dummy_length),
         damping: slice(&rig.damping),
