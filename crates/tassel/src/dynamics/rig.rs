@@ -175,6 +175,15 @@ pub struct RigSettings {
     /// joins the tips (`bAutoAddChildDummyBoneConstraint`; default true).
     #[serde(default = "yes")]
     pub auto_add_child_dummy_bone_constraint: bool,
+    /// Bridge points on each bone constraint, 0..=10 (KawaiiPhysics 1.21's
+    /// `BoneConstraintSubdivisionCount`; default 0): collision sensors between the two
+    /// points that close the gap a leg passes through between a skirt's columns.
+    #[serde(default, skip_serializing_if = "is_zero_u32")]
+    pub bone_constraint_subdivision_count: u32,
+    /// How much of a bridge point's push reaches the constraint's two points, 0..=2
+    /// (`BoneConstraintSubdivisionFeedbackScale`; default 1).
+    #[serde(default = "one_f32", skip_serializing_if = "is_one_f32")]
+    pub bone_constraint_subdivision_feedback_scale: f32,
     /// How `fixed` mode steps the model's VRM spring bones (`[vrm]`: `step_rate`,
     /// `max_steps_per_frame`).
     #[serde(default, skip_serializing_if = "VrmStepping::is_default")]
@@ -220,6 +229,18 @@ fn one() -> u32 {
     1
 }
 
+fn one_f32() -> f32 {
+    1.0
+}
+
+fn is_one_f32(v: &f32) -> bool {
+    *v == 1.0
+}
+
+fn is_zero_u32(n: &u32) -> bool {
+    *n == 0
+}
+
 fn yes() -> bool {
     true
 }
@@ -231,6 +252,8 @@ impl Default for RigSettings {
             bone_constraint_iteration_count_before_collision: 0,
             bone_constraint_iteration_count_after_collision: 1,
             auto_add_child_dummy_bone_constraint: true,
+            bone_constraint_subdivision_count: 0,
+            bone_constraint_subdivision_feedback_scale: 1.0,
             vrm: VrmStepping::default(),
             chains: Vec::new(),
             colliders: Vec::new(),
@@ -455,6 +478,18 @@ impl RigSettings {
                 )));
             }
         }
+        if self.bone_constraint_subdivision_count > 10 {
+            return Err(Error::InvalidParameter(format!(
+                "bone_constraint_subdivision_count = {} must be 0..=10",
+                self.bone_constraint_subdivision_count
+            )));
+        }
+        let scale = self.bone_constraint_subdivision_feedback_scale;
+        if !(0.0..=2.0).contains(&scale) {
+            return Err(Error::InvalidParameter(format!(
+                "bone_constraint_subdivision_feedback_scale = {scale} must be 0..=2"
+            )));
+        }
         for (i, c) in self.bone_constraints.iter().enumerate() {
             c.validate(i + 1)?;
         }
@@ -489,6 +524,8 @@ impl RigSettings {
             iterations_before_collision: self.bone_constraint_iteration_count_before_collision,
             iterations_after_collision: self.bone_constraint_iteration_count_after_collision,
             auto_add_child_dummy: self.auto_add_child_dummy_bone_constraint,
+            subdivision_count: self.bone_constraint_subdivision_count,
+            feedback_scale: self.bone_constraint_subdivision_feedback_scale,
         }
     }
 

@@ -399,6 +399,7 @@ impl ChainRig {
                 .push((j, p, s..out.rotator_children.len() as u32));
         }
         out.constraints = out.compile_constraints(skeleton, rig, &rest.models)?;
+        out.constraints.all_colliders = (0..out.colliders.len()).collect();
         out.syncs = super::sync::compile(
             skeleton,
             &rig.sync_bones,
@@ -486,6 +487,7 @@ impl ChainRig {
             parent: &self.parent,
             real_parent: &self.real_parent,
             dummy_length: &self.dummy_length,
+            radius: &self.radius,
             chain_of: &self.chain_of,
             rest: &rest,
         };
@@ -610,6 +612,18 @@ impl ChainRig {
                 self.rotator_children[kids.start as usize] as usize,
             )
         })
+    }
+
+    /// How many bridge points the bone constraints have (`bone_constraint_subdivision_count`).
+    pub fn bridge_count(&self) -> usize {
+        self.constraints.bridges.len()
+    }
+
+    /// Bridge point `i`: the two points of its bone constraint, how far from the first
+    /// toward the second it lies (0..1), and its radius. `None` past the last.
+    pub fn bridge(&self, i: usize) -> Option<(usize, usize, f32, f32)> {
+        let b = self.constraints.bridges.get(i)?;
+        Some((b.a as usize, b.b as usize, b.alpha, b.radius))
     }
 
     /// The collision radius of point `p`.

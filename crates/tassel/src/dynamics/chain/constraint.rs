@@ -180,6 +180,11 @@ pub struct BoneConstraintSettings {
     /// (KawaiiPhysics' `bOverrideCompliance` off).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub compliance: Option<Compliance>,
+    /// Put no bridge points on this pair (`bone_constraint_subdivision_count`; its dummy
+    /// tips' pair too): KawaiiPhysics 1.21's `bExcludeFromSubdivision`, for structural or
+    /// diagonal constraints.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub exclude_from_subdivision: bool,
 }
 
 impl BoneConstraintSettings {
@@ -296,6 +301,12 @@ pub struct BoneConstraintOptions {
     pub iterations_after_collision: u32,
     /// A constraint whose two bones both end in a dummy tip also joins the tips.
     pub auto_add_child_dummy: bool,
+    /// Bridge points on each constraint (0..=10; KawaiiPhysics 1.21's
+    /// `BoneConstraintSubdivisionCount`).
+    pub subdivision_count: u32,
+    /// How much of a bridge point's push reaches the constraint's two points (0..=2;
+    /// `BoneConstraintSubdivisionFeedbackScale`).
+    pub feedback_scale: f32,
 }
 
 /// A compiled constraint between points `a` and `b`.
@@ -306,6 +317,20 @@ pub(crate) struct CompiledConstraint {
     /// Rest distance: the points' distance in the skeleton's rest pose.
     pub rest: f32,
     pub compliance: f32,
+    /// Bridge points may be put on it (not `exclude_from_subdivision`).
+    pub bridged: bool,
+}
+
+/// A bridge point on a bone constraint (KawaiiPhysics 1.21's bridge dummy): a collision
+/// sensor at `alpha` of the way from point `a` to point `b`, placed there each step, whose
+/// push by the colliders moves `a` and `b` by their shares.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Bridge {
+    pub a: u32,
+    pub b: u32,
+    pub alpha: f32,
+    /// The mean of the two points' radii.
+    pub radius: f32,
 }
 
 /// Chains joined by bone constraints: stepped together.
@@ -316,6 +341,8 @@ pub(crate) struct ChainGroup {
     /// The group's constraints in `ChainRig::constraints`, in file order, then the dummy
     /// tips' (as KawaiiPhysics appends them).
     pub constraints: Range<usize>,
+    /// The group's bridge points in `Constraints::bridges`.
+    pub bridges: Range<usize>,
 }
 
 /// Everything the chain rig keeps of its bone constraints.
@@ -327,6 +354,11 @@ pub(crate) struct Constraints {
     pub group_of: Vec<u32>,
     pub before: u32,
     pub after: u32,
+    /// Bridge points, group by group, and how much of their push reaches their ends.
+    pub bridges: Vec<Bridge>,
+    pub feedback_scale: f32,
+    /// Every rig collider (bridge points collide with all of them).
+    pub all_colliders: Vec<usize>,
 }
 
 /// What [`compile`] needs of the chain points.
@@ -340,6 +372,8 @@ pub(crate) struct PointTable<'a> {
     pub chain_of: &'a [u16],
     /// Rest-pose position of every point (virtual tips included).
     pub rest: &'a [Vec3],
+    /// Collision radius of every point.
+    pub radius: &'a [f32],
 }
 
 /// Resolves `entries` on `skeleton` against the compiled chain points.
@@ -355,6 +389,7 @@ pub(crate) fn compile(
         group_of: vec![u32::MAX; chains.len()],
         before: options.iterations_before_collision,
         after: options.iterations_after_collision,
+        feedback_scale: options.feedback_scale,
         ..Default::default()
     };
     if entries.is_empty() {
@@ -366,11 +401,12 @@ pub(crate) fn compile(
             point_of[j as usize] = p as u32;
         }
     }
-    let constraint = |a: usize, b: usize, compliance: f32| CompiledConstraint {
+    let constraint = |a: usize, b: usize, compliance: f32, bridged: bool| CompiledConstraint {
         a: a as u32,
         b: b as u32,
         rest: (points.rest[b] - points.rest[a]).length(),
         compliance,
+        bridged,
     };
     let dummy_child = |p: usize| {
         let chain = &chains[points.chain_of[p] as usize];
@@ -406,10 +442,11 @@ pub(crate) fn compile(
                     skeleton.name(ja)
                 )));
             }
-            list.push(constraint(a, b, compliance));
+            let bridged = !e.exclude_from_subdivision;
+            list.push(constraint(a, b, compliance, bridged));
             if options.auto_add_child_dummy {
                 if let (Some(da), Some(db)) = (dummy_child(a), dummy_child(b)) {
-                    dummies.push(constraint(da, db, compliance));
+                    dummies.push(constraint(da, db, compliance, bridged));
                 }
             }
             if list.len() + dummies.len() > crate::limits::MAX_BONE_CONSTRAINTS {
@@ -462,6 +499,7 @@ pub(crate) fn compile(
             out.groups.push(ChainGroup {
                 chains: Vec::new(),
                 constraints: 0..0,
+                bridges: 0..0,
             });
         }
         let g = out.group_of[r];
@@ -478,6 +516,27 @@ pub(crate) fn compile(
         );
         group.constraints = start..out.list.len();
         check_group(chains, group)?;
+        // Bridge points (KawaiiPhysics 1.21's `InsertBridgeDummiesForConstraints`): on
+        // every constraint not excluded, unless its two points' spheres already overlap at
+        // rest (KINDA_SMALL_NUMBER, 1e-4 cm, in metres).
+        let first = out.bridges.len();
+        for c in &out.list[group.constraints.clone()] {
+            let (a, b) = (c.a as usize, c.b as usize);
+            let (ra, rb) = (points.radius[a], points.radius[b]);
+            if !c.bridged || c.rest <= (ra + rb).max(1e-6) {
+                continue;
+            }
+            let n = options.subdivision_count.min(10) as usize;
+            for k in 0..n {
+                out.bridges.push(Bridge {
+                    a: c.a,
+                    b: c.b,
+                    alpha: (k + 1) as f32 / (n + 1) as f32,
+                    radius: 0.5 * (ra + rb),
+                });
+            }
+        }
+        group.bridges = first..out.bridges.len();
     }
     Ok(out)
 }

@@ -3,7 +3,7 @@
 use super::compile::{ChainRig, NONE, VIRTUAL};
 use super::constraint::ChainGroup;
 use super::settings::TimeMode;
-use super::step::{step_chain, step_group, GroupRef, StepInput};
+use super::step::{step_chain, step_group, Bridges, GroupRef, StepInput};
 use crate::collide::{NearSet, PlacedCollider};
 use crate::controller::Level;
 use crate::dynamics::chain::lanes::twins::{ChainLanes, LaneFrame, ScalarChains};
@@ -35,6 +35,16 @@ pub struct ChainState {
     /// the kept state is not touched.
     keep_prev: Vec<Vec3>,
     keep_rng: Vec<SplitMix64>,
+    /// Bridge points on the bone constraints (`bone_constraint_subdivision_count`): their
+    /// places after the last step and before it; the output step's copies; per point the
+    /// pushes they feed back (empty without bridges).
+    bridge_pos: Vec<Vec3>,
+    bridge_prev: Vec<Vec3>,
+    /// The bridge points as the frame outputs them (fixed mode's output step's).
+    bridge_out: Vec<Vec3>,
+    keep_bridge_pos: Vec<Vec3>,
+    keep_bridge_prev: Vec<Vec3>,
+    feedback: Vec<Vec4>,
     targets: Vec<Vec3>,
     prev_targets: Vec<Vec3>,
     step_targets: Vec<Vec3>,
@@ -107,6 +117,16 @@ impl ChainState {
             out: vec![Vec3::ZERO; n],
             keep_prev: vec![Vec3::ZERO; n],
             keep_rng: (0..c).map(|ci| chain_rng(rig, ci)).collect(),
+            bridge_pos: vec![Vec3::ZERO; rig.constraints.bridges.len()],
+            bridge_prev: vec![Vec3::ZERO; rig.constraints.bridges.len()],
+            bridge_out: vec![Vec3::ZERO; rig.constraints.bridges.len()],
+            keep_bridge_pos: vec![Vec3::ZERO; rig.constraints.bridges.len()],
+            keep_bridge_prev: vec![Vec3::ZERO; rig.constraints.bridges.len()],
+            feedback: if rig.constraints.bridges.is_empty() {
+                Vec::new()
+            } else {
+                vec![Vec4::ZERO; n]
+            },
             targets: vec![Vec3::ZERO; n],
             prev_targets: vec![Vec3::ZERO; n],
             step_targets: vec![Vec3::ZERO; n],
@@ -291,6 +311,13 @@ impl ChainState {
             ));
         }
         Ok(())
+    }
+
+    /// The bridge points on the bone constraints (`bone_constraint_subdivision_count`) as
+    /// the last frame left them (in `fixed` mode, its output step's), model space;
+    /// [`ChainRig::bridge`] says where each lies.
+    pub fn bridge_positions(&self) -> &[Vec3] {
+        &self.bridge_out
     }
 
     /// The simulated point positions of the last frame's output, model space.
@@ -919,6 +946,7 @@ fn run_chain(
                 let alone = GroupRef {
                     chains: std::slice::from_ref(&ci),
                     constraints: 0..0,
+                    bridges: 0..0,
                 };
                 run_kawaii(rig, alone, state, component, dt, level);
             }
@@ -1016,14 +1044,15 @@ fn output_step(
 }
 
 /// [`output_step`] for bone-constraint group `group` (one clock: its lead chain's):
-/// the group's chains step on together.
+/// the group's chains step on together (with their bridge points, in copies). Returns
+/// whether an output step ran.
 fn output_step_group(
     rig: &ChainRig,
     group: &ChainGroup,
     state: &mut ChainState,
     component: &Transform,
     level: Option<&Level>,
-) {
+) -> bool {
     let lead = group.chains[0];
     for &ci in &group.chains {
         let points = rig.chains[ci].points.clone();
@@ -1032,7 +1061,7 @@ fn output_step_group(
     let h = 1.0 / rig.chains[lead].settings.target_framerate;
     let left = state.accumulator[lead];
     if left <= ON_STEP * h {
-        return;
+        return false;
     }
     let from = state.last_step_component[lead];
     for &ci in &group.chains {
@@ -1055,10 +1084,15 @@ fn output_step_group(
         );
     }
     state.keep_rng.copy_from_slice(&state.rng);
+    state.keep_bridge_pos.copy_from_slice(&state.bridge_pos);
+    state.keep_bridge_prev.copy_from_slice(&state.bridge_prev);
     let ChainState {
         out,
         keep_prev,
         keep_rng,
+        keep_bridge_pos,
+        keep_bridge_prev,
+        feedback,
         lambda,
         targets,
         normals,
@@ -1094,7 +1128,13 @@ fn output_step_group(
         keep_prev,
         keep_rng,
         lambda,
+        &mut Bridges {
+            pos: keep_bridge_pos,
+            prev: keep_bridge_prev,
+            feedback,
+        },
     );
+    true
 }
 
 /// Whether the character's motion this frame crosses chain settings `s`' teleport
@@ -1301,6 +1341,9 @@ fn run_kawaii(
             prev,
             rng,
             lambda,
+            bridge_pos,
+            bridge_prev,
+            feedback,
             step_targets,
             step_normals,
             colliders,
@@ -1326,7 +1369,20 @@ fn run_kawaii(
             let s = &rig.chains[ci].settings;
             frame.input(rig, ci, h, h, accelerates(s), Some(share))
         };
-        step_group(rig, group.clone(), &input_of, pos, prev, rng, lambda);
+        step_group(
+            rig,
+            group.clone(),
+            &input_of,
+            pos,
+            prev,
+            rng,
+            lambda,
+            &mut Bridges {
+                pos: bridge_pos,
+                prev: bridge_prev,
+                feedback,
+            },
+        );
     }
     let advanced = if consumed >= 1.0 - 1e-4 {
         *component
@@ -1572,6 +1628,9 @@ fn run_group(
                         prev,
                         rng,
                         lambda,
+                        bridge_pos,
+                        bridge_prev,
+                        feedback,
                         targets,
                         normals,
                         colliders,
@@ -1595,7 +1654,20 @@ fn run_group(
                         component,
                     };
                     let input_of = |ci: usize| frame.input(rig, ci, dt, dt_old[ci], false, None);
-                    step_group(rig, group.into(), &input_of, pos, prev, rng, lambda);
+                    step_group(
+                        rig,
+                        group.into(),
+                        &input_of,
+                        pos,
+                        prev,
+                        rng,
+                        lambda,
+                        &mut Bridges {
+                            pos: bridge_pos,
+                            prev: bridge_prev,
+                            feedback,
+                        },
+                    );
                     group.chains.iter().for_each(|&ci| dt_old[ci] = dt);
                 }
                 for &ci in &group.chains {
@@ -1621,8 +1693,14 @@ fn run_group(
         reset_group(rig, group, state, component);
         reset = true;
     }
-    if s.mode == TimeMode::Fixed {
-        output_step_group(rig, group, state, component, level);
+    let stepped =
+        s.mode == TimeMode::Fixed && output_step_group(rig, group, state, component, level);
+    for i in group.bridges.clone() {
+        state.bridge_out[i] = if stepped {
+            state.keep_bridge_pos[i]
+        } else {
+            state.bridge_pos[i]
+        };
     }
     for &ci in &group.chains {
         output_chain(rig, ci, state, component, level, reset);
@@ -1634,6 +1712,12 @@ fn reset_group(rig: &ChainRig, group: &ChainGroup, state: &mut ChainState, compo
     for &ci in &group.chains {
         reset_chain(rig, ci, state, component, false);
     }
+    for i in group.bridges.clone() {
+        let br = &rig.constraints.bridges[i];
+        let at = state.targets[br.a as usize].lerp(state.targets[br.b as usize], br.alpha);
+        state.bridge_pos[i] = at;
+        state.bridge_prev[i] = at;
+    }
     let s = &rig.chains[group.chains[0]].settings;
     let h = 1.0 / s.target_framerate;
     let fixed = accelerates(s);
@@ -1643,6 +1727,9 @@ fn reset_group(rig: &ChainRig, group: &ChainGroup, state: &mut ChainState, compo
             prev,
             rng,
             lambda,
+            bridge_pos,
+            bridge_prev,
+            feedback,
             targets,
             normals,
             colliders,
@@ -1671,7 +1758,20 @@ fn reset_group(rig: &ChainRig, group: &ChainGroup, state: &mut ChainState, compo
             }
         };
         for _ in 0..s.warmup_steps {
-            step_group(rig, group.into(), &input_of, pos, prev, rng, lambda);
+            step_group(
+                rig,
+                group.into(),
+                &input_of,
+                pos,
+                prev,
+                rng,
+                lambda,
+                &mut Bridges {
+                    pos: bridge_pos,
+                    prev: bridge_prev,
+                    feedback,
+                },
+            );
         }
     }
     for &ci in &group.chains {
@@ -1728,6 +1828,9 @@ fn run_fixed_group(
                 prev,
                 rng,
                 lambda,
+                bridge_pos,
+                bridge_prev,
+                feedback,
                 step_targets,
                 step_normals,
                 step_colliders,
@@ -1768,7 +1871,20 @@ fn run_fixed_group(
                     base,
                 }
             };
-            step_group(rig, group.into(), &input_of, pos, prev, rng, lambda);
+            step_group(
+                rig,
+                group.into(),
+                &input_of,
+                pos,
+                prev,
+                rng,
+                lambda,
+                &mut Bridges {
+                    pos: bridge_pos,
+                    prev: bridge_prev,
+                    feedback,
+                },
+            );
         }
         for &ci in &group.chains {
             state.last_step_component[ci] = comp_b;

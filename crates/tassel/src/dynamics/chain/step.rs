@@ -314,6 +314,7 @@ pub(crate) fn step_chain(
 pub(crate) struct GroupRef<'g> {
     pub chains: &'g [usize],
     pub constraints: std::ops::Range<usize>,
+    pub bridges: std::ops::Range<usize>,
 }
 
 impl<'g> From<&'g ChainGroup> for GroupRef<'g> {
@@ -321,6 +322,7 @@ impl<'g> From<&'g ChainGroup> for GroupRef<'g> {
         GroupRef {
             chains: &g.chains,
             constraints: g.constraints.clone(),
+            bridges: g.bridges.clone(),
         }
     }
 }
@@ -330,6 +332,7 @@ impl<'g> From<&'g ChainGroup> for GroupRef<'g> {
 /// collided; `after` passes; then every point limited and put back at its bone length
 /// (and settled against the colliders, Tassel's last word as in [`step_chain`]).
 /// `input_of(ci)` is chain `ci`'s step input; the constraints use the first chain's `dt`.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn step_group<'a>(
     rig: &ChainRig,
     group: GroupRef,
@@ -338,6 +341,7 @@ pub(crate) fn step_group<'a>(
     prev: &mut [Vec3],
     rngs: &mut [SplitMix64],
     lambda: &mut [f32],
+    bridges: &mut Bridges,
 ) {
     for &ci in group.chains {
         let chain = &rig.chains[ci];
@@ -398,10 +402,16 @@ pub(crate) fn step_group<'a>(
             }
         }
     }
+    // Bridge points: on their constraint, between its two points' new places.
+    let on_bridges = &rig.constraints.bridges[group.bridges.clone()];
+    for (i, br) in group.bridges.clone().zip(on_bridges) {
+        bridges.prev[i] = bridges.pos[i];
+        bridges.pos[i] = pos[br.a as usize].lerp(pos[br.b as usize], br.alpha);
+    }
     let lead = input_of(group.chains[0]);
     let (dt, part) = (lead.dt, lead.part);
     let list = &rig.constraints.list[group.constraints.clone()];
-    let lambda = &mut lambda[group.constraints];
+    let lambda = &mut lambda[group.constraints.clone()];
     solve(list, lambda, pos, dt, rig.constraints.before, part);
     for &ci in group.chains {
         let chain = &rig.chains[ci];
@@ -418,6 +428,9 @@ pub(crate) fn step_group<'a>(
             let contact = Contact::at(rig, &chain.colliders, &input, p, pp, pos, prev);
             pos[p] = contact.resolve(pos[p]);
         }
+    }
+    if !on_bridges.is_empty() {
+        collide_bridges(rig, group.clone(), input_of, pos, bridges, part);
     }
     solve(list, lambda, pos, dt, rig.constraints.after, part);
     for &ci in group.chains {
@@ -442,6 +455,67 @@ pub(crate) fn step_group<'a>(
                 &contact,
                 collides,
             );
+        }
+    }
+}
+
+/// The bridge points of a group's step (their places this step and last), and a
+/// per-point scratch for the pushes they feed back.
+pub(crate) struct Bridges<'b> {
+    pub pos: &'b mut [Vec3],
+    pub prev: &'b mut [Vec3],
+    /// Per chain point: the pushes fed back to it (xyz) and their weights (w).
+    pub feedback: &'b mut [glam::Vec4],
+}
+
+/// The bridge points of `group` against every rig collider and the world (the first of
+/// the group's chains that collides with it), swept from their last place; then each
+/// point's push (where it went from where it was put) fed back to the constraint's two
+/// points by their nearness, `1 − alpha` and `alpha`, a point's sum divided by its
+/// weight where that passes 1, times `feedback_scale` (KawaiiPhysics 1.21's bridge
+/// feedback, between the collision pass and the after-collision constraint pass). `part`
+/// scales the feedback in fixed mode's output step.
+fn collide_bridges<'a>(
+    rig: &ChainRig,
+    group: GroupRef,
+    input_of: &dyn Fn(usize) -> StepInput<'a>,
+    pos: &mut [Vec3],
+    bridges: &mut Bridges,
+    part: f32,
+) {
+    let input = input_of(group.chains[0]);
+    let world = group
+        .chains
+        .iter()
+        .find_map(|&ci| input_of(ci).world.map(|w| (w, ci)));
+    let all = &rig.constraints.all_colliders;
+    let scale = rig.constraints.feedback_scale * part;
+    let on_bridges = &rig.constraints.bridges[group.bridges.clone()];
+    for (i, br) in group.bridges.clone().zip(on_bridges) {
+        let (from, put) = (bridges.prev[i], bridges.pos[i]);
+        let near = NearSet::of(all, input.bounds, from.min(put), from.max(put), br.radius);
+        let mut x = near.resolve(all, input.colliders, put, Some(from), br.radius);
+        if let Some((w, _)) = &world {
+            x = w.resolve(x, from, br.radius);
+        }
+        bridges.pos[i] = x;
+        let push = x - put;
+        // UE's `IsNearlyZero` (1e-4 cm a component), in metres.
+        if scale > 0.0 && push.abs().max_element() > 1e-6 {
+            let (a, b) = (br.a as usize, br.b as usize);
+            bridges.feedback[a] += (push * (1.0 - br.alpha)).extend(1.0 - br.alpha);
+            bridges.feedback[b] += (push * br.alpha).extend(br.alpha);
+        }
+    }
+    if scale > 0.0 {
+        for br in on_bridges {
+            for e in [br.a as usize, br.b as usize] {
+                let f = bridges.feedback[e];
+                if f.w > 0.0 {
+                    pos[e] += f.truncate() / f.w.max(1.0) * scale;
+                    bridges.feedback[e] = glam::Vec4::ZERO;
+                }
+            }
         }
     }
 }
