@@ -272,3 +272,33 @@ fn bridge_keys_counts_and_feedback() {
         "the feedback moves the skirt"
     );
 }
+
+/// A state made for the same skirt with another number of bridge points (the same
+/// points, chains, colliders and constraints) is refused by name, not read out of bounds.
+#[test]
+fn a_state_of_a_rig_with_other_bridges_is_refused() {
+    use tassel::dynamics::chain::{ChainJob, ChainRig, ChainState};
+    let c = builtin::character();
+    let sk = &c.skeleton;
+    let with = ChainRig::new(sk, &skirt_rig(3)).unwrap();
+    let without = ChainRig::new(sk, &skirt_rig(0)).unwrap();
+    assert_eq!(with.point_count(), without.point_count());
+    for (rig, other) in [(&with, &without), (&without, &with)] {
+        let mut wrong = ChainState::new(other);
+        let mut locals = sk.rest().to_vec();
+        let mut models = tassel::Pose::rest(sk).models;
+        let err = ChainJob {
+            skeleton: sk,
+            rig,
+            state: &mut wrong,
+            component: Transform::IDENTITY,
+            dt: 1.0 / 60.0,
+            locals: &mut locals,
+            models: &mut models,
+            level: None,
+        }
+        .run()
+        .unwrap_err();
+        assert!(err.to_string().contains("another chain rig"), "{err}");
+    }
+}

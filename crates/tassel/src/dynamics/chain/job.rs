@@ -402,6 +402,13 @@ impl ChainJob<'_> {
             && state.colliders.len() == self.rig.colliders.len()
             && state.lanes.len() == self.rig.lane_groups.len()
             && state.lambda.len() == self.rig.constraints.list.len()
+            && state.bridge_pos.len() == self.rig.constraints.bridges.len()
+            && state.feedback.len()
+                == if self.rig.constraints.bridges.is_empty() {
+                    0
+                } else {
+                    self.rig.point_count()
+                }
             && state.alpha.len() == self.rig.chains.len()
             && state.base_now.len() == self.rig.chains.len()
             && state.forces.fits(self.rig)
