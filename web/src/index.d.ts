@@ -41,10 +41,37 @@ declare class Stepped {
   teleport(): void;
   /** Acts on an animation event starting with `tassel:` (`tassel:reset_dynamics`,
    *  `tassel:set_alpha 0.3 [chain]`, `tassel:enable_force NAME`, `tassel:disable_force NAME`,
-   *  `tassel:force_once NAME`): true when it acted, false for the game's own events;
-   *  throws on a malformed one or a name that does not exist. */
+   *  `tassel:force_once NAME`, `tassel:override NAME stiffness=0.5 duration=2 ...`,
+   *  `tassel:stop_override NAME [blend_out]`): true when it acted, false for the game's
+   *  own events; throws on a malformed one or a name that does not exist. */
   event(name: string): boolean;
+  /** Starts a timed settings override of the rig's chains (KawaiiPhysics'
+   *  StartPhysicsSettingsOverride): the scales (unset: 1) act on `chain` (unset: every
+   *  chain) for `duration` seconds (Infinity: until stopped), blending in and out; up to 8
+   *  at once, multiplying. Returns the handle; throws on a bad scale, time or chain. */
+  startSettingsOverride(scale?: SettingsScale, options?: SettingsOverrideOptions): number;
+  /** Stops a settings override by its handle over `blendOut` seconds (0: at once): true
+   *  when one had the handle. */
+  stopSettingsOverride(handle: number, blendOut?: number): boolean;
   dispose(): void;
+}
+
+/** Multipliers of a chain's settings (1: no change). */
+export interface SettingsScale {
+  damping?: number;
+  stiffness?: number;
+  worldDampingLocation?: number;
+  worldDampingRotation?: number;
+  radius?: number;
+  limitAngle?: number;
+}
+
+/** When a settings override acts: KawaiiPhysics' defaults 2 s, 0.2 s in, 0.5 s out. */
+export interface SettingsOverrideOptions {
+  duration?: number;
+  blendIn?: number;
+  blendOut?: number;
+  chain?: string | null;
 }
 
 /** A drop-in for three-vrm's VRMSpringBoneManager, stepped by Tassel. */

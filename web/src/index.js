@@ -12,6 +12,8 @@
 //   character.update(delta);           // after AnimationMixer.update(delta)
 
 const FLOATS = 10; // tx ty tz qx qy qz qw sx sy sz
+// A settings override's scales, in the C ABI's order.
+const SCALE_NAMES = ['damping', 'stiffness', 'worldDampingLocation', 'worldDampingRotation', 'radius', 'limitAngle'];
 
 let modulePromise = null;
 
@@ -398,8 +400,9 @@ class Driver {
 
   /** Acts on an animation event starting with `tassel:` (`tassel:reset_dynamics`,
    *  `tassel:set_alpha 0.3 [chain]`, `tassel:enable_force NAME`, `tassel:disable_force
-   *  NAME`, `tassel:force_once NAME`): true when it acted, false for the game's own
-   *  events; throws on a malformed one or a name that does not exist. */
+   *  NAME`, `tassel:force_once NAME`, `tassel:override NAME stiffness=0.5 duration=2 ...`,
+   *  `tassel:stop_override NAME [blend_out]`): true when it acted, false for the game's
+   *  own events; throws on a malformed one or a name that does not exist. */
   event(name) {
     const text = this.tassel.cstring(name);
     try {
@@ -409,6 +412,36 @@ class Driver {
     } finally {
       this.tassel.free(text);
     }
+  }
+
+  /** Starts a timed settings override of the rig's chains (KawaiiPhysics'
+   *  StartPhysicsSettingsOverride): `scale` multiplies `damping`, `stiffness`,
+   *  `worldDampingLocation`, `worldDampingRotation`, `radius` and `limitAngle` (unset: 1)
+   *  of the chain named `chain` (unset: every chain) for `duration` seconds (Infinity:
+   *  until stopped), blending in over `blendIn` and out over `blendOut`. Up to 8 act at
+   *  once and they multiply. Returns a handle for `stopSettingsOverride`; throws on a bad
+   *  scale, time or chain. */
+  startSettingsOverride(scale = {}, { duration = 2, blendIn = 0.2, blendOut = 0.5, chain = null } = {}) {
+    const six = new Float32Array(SCALE_NAMES.map((n) => scale[n] ?? 1));
+    const buf = this.tassel.copyIn(new Uint8Array(six.buffer));
+    const name = this.tassel.cstring(chain);
+    try {
+      const h = this.tassel.x.tassel_start_settings_override(
+        this.ptr, buf[0], duration, blendIn, blendOut, name[0]);
+      if (h < 0) throw this.tassel.error('the settings override failed');
+      return h;
+    } finally {
+      this.tassel.free(buf);
+      this.tassel.free(name);
+    }
+  }
+
+  /** Stops a settings override by its handle, blending out over `blendOut` seconds (0: at
+   *  once): true when one had the handle, false when it had ended. */
+  stopSettingsOverride(handle, blendOut = 0.5) {
+    const r = this.tassel.x.tassel_stop_settings_override(this.ptr, handle, blendOut);
+    if (r < 0) throw this.tassel.error('stopping the settings override failed');
+    return r === 1;
   }
 
   update(delta) {
@@ -525,6 +558,11 @@ class Stepped {
    *  NAME`, `tassel:force_once NAME`): true when it acted, false for the game's own events;
    *  throws on a malformed one or a name that does not exist. */
   event(name) { return this._driver.event(name); }
+  /** Starts a timed settings override of the rig's chains (see the README): returns its
+   *  handle. */
+  startSettingsOverride(scale, options) { return this._driver.startSettingsOverride(scale, options); }
+  /** Stops a settings override by its handle: true when one had it. */
+  stopSettingsOverride(handle, blendOut) { return this._driver.stopSettingsOverride(handle, blendOut); }
   /** Frees the module's memory for this character. */
   dispose() { this._driver.dispose(); }
 }

@@ -2,7 +2,7 @@
 // its crowd against its manager (crowd.mjs), on every VRM file of ../shared/testdata/vrm.
 import fs from 'node:fs';
 import path from 'node:path';
-import { TasselSpringBoneManager, TasselCrowd } from '../dist/index.js';
+import { TasselSpringBoneManager, TasselCrowd, TasselCharacter } from '../dist/index.js';
 import { loadGltfBytes } from './gltf.mjs';
 import { vrmFiles, testdata, THREE } from './load.mjs';
 import { runParity } from './parity.mjs';
@@ -27,8 +27,34 @@ async function runEvents() {
   try { m.event('tassel:enable_force nope'); } catch (e) { thrown = e.message; }
   ok(thrown !== null && thrown.includes("'nope'"), `an unknown force is an error naming it: ${thrown}`);
   ok(m.update(1 / 60), `an update after the events: ${m.lastError}`);
+  // Timed settings overrides through tassel_start_settings_override: refused on a file
+  // without chains; on a skinned glTF with a chain (RiggedSimple.glb's two bones), a handle, a bad scale refused by name, a stop answered while it acts and not
+  // after it ended, the events.
+  thrown = null;
+  try { m.startSettingsOverride({ stiffness: 0.5 }); } catch (e) { thrown = e.message; }
+  ok(thrown !== null && thrown.includes('no chains'), `no chains, no override: ${thrown}`);
+  const rigged = fs.readFileSync(path.join(testdata, 'gltf/RiggedSimple.glb'));
+  const r = await loadGltfBytes(rigged);
+  const root = 'Bone';
+  const c = await TasselCharacter.fromGLTF(r.gltf, r.data, `[[chain]]\nname = "hair"\nroot = "${root}"\n`);
+  ok(c.update(1 / 60), `a chain on ${root}: ${c.lastError}`);
+  const h = c.startSettingsOverride({ stiffness: 0.5 }, { duration: Infinity, blendIn: 0.1, chain: 'hair' });
+  ok(Number.isInteger(h) && h > 0, `a settings override's handle: ${h}`);
+  thrown = null;
+  try { c.startSettingsOverride({ radius: -1 }); } catch (e) { thrown = e.message; }
+  ok(thrown !== null && thrown.includes('radius'), `a negative scale is an error naming it: ${thrown}`);
+  thrown = null;
+  try { c.startSettingsOverride({}, { chain: 'tail' }); } catch (e) { thrown = e.message; }
+  ok(thrown !== null && thrown.includes("'tail'"), `an unknown chain is an error naming it: ${thrown}`);
+  ok(c.update(1 / 60), `an update with an override: ${c.lastError}`);
+  ok(c.stopSettingsOverride(h, 0) === true, 'stopping an acting override');
+  ok(c.update(1 / 60), `an update after the stop: ${c.lastError}`);
+  ok(c.stopSettingsOverride(h, 0) === false, 'an ended override is no one\'s');
+  ok(c.event('tassel:override slow stiffness=0.5 duration=1') === true, 'tassel:override acts');
+  ok(c.event('tassel:stop_override slow') === true, 'tassel:stop_override acts');
+  c.dispose();
   m.dispose();
-  console.log(bad ? 'events: FAILED' : 'events: tassel:reset_dynamics acts, a game event passes, a bad one throws');
+  console.log(bad ? 'events: FAILED' : 'events: tassel:reset_dynamics acts, a game event passes, a bad one throws; settings overrides start, stop and refuse a bad scale');
   return bad;
 }
 failures += await runEvents();

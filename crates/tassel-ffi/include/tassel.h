@@ -154,7 +154,8 @@ void tassel_teleport(TasselCharacter *c);
 // Acts on an animation event (a NUL-terminated UTF-8 string) as KawaiiPhysics' anim
 // notifies do: `tassel:reset_dynamics`, `tassel:set_alpha 0.3 [chain]`,
 // `tassel:enable_force NAME`, `tassel:disable_force NAME`, `tassel:force_once NAME` (the
-// forces of the rig file's `[[external_force]]`). Returns 1 when it acted, 0 for an event
+// forces of the rig file's `[[external_force]]`), `tassel:override NAME stiffness=0.5
+// duration=2 ...` and `tassel:stop_override NAME [blend_out]` (timed settings overrides). Returns 1 when it acted, 0 for an event
 // that does not start with `tassel:` (the game's own), -1 on error (a malformed event, a
 // force or chain that does not exist, NULL; `tassel_last_error` says which).
 //
@@ -162,6 +163,36 @@ void tassel_teleport(TasselCharacter *c);
 // `c` is NULL or a live character; `event` is NULL or a NUL-terminated string.
 int32_t tassel_event(TasselCharacter *c,
                      const char *event);
+
+// Starts a timed settings override of the chains (KawaiiPhysics'
+// `StartPhysicsSettingsOverride`): `scales` points to six multipliers, in order damping,
+// stiffness, world damping location, world damping rotation, radius, limit angle (1: no
+// change); they act on the chain named `chain` (NULL: every chain) for `duration`
+// seconds (`INFINITY`: until stopped), blending in over `blend_in` and out over
+// `blend_out`, from the next frame. Up to 8 act at once (a ninth drops the oldest); they
+// multiply. Returns the override's handle (> 0, for `tassel_stop_settings_override`), or
+// -1 on error (a negative or non-finite scale, a duration not > 0, a chain that does not
+// exist, NULL; `tassel_last_error` says which).
+//
+// # Safety
+// `c` is NULL or a live character; `scales` is NULL or points to 6 floats; `chain` is
+// NULL or a NUL-terminated string.
+int32_t tassel_start_settings_override(TasselCharacter *c,
+                                       const float *scales,
+                                       float duration,
+                                       float blend_in,
+                                       float blend_out,
+                                       const char *chain);
+
+// Stops a settings override by the handle `tassel_start_settings_override` gave: it
+// blends out from where it is over `blend_out` seconds (0: at once). Returns 1 when an
+// override had the handle, 0 when none did (it ended), -1 for NULL.
+//
+// # Safety
+// `c` is NULL or a live character.
+int32_t tassel_stop_settings_override(TasselCharacter *c,
+                                      int32_t handle,
+                                      float blend_out);
 
 // How many joints a solver writes (the others' output is their input). 0 for NULL.
 //

@@ -442,7 +442,8 @@ pub unsafe extern "C" fn tassel_teleport(c: *mut TasselCharacter) {
 /// Acts on an animation event (a NUL-terminated UTF-8 string) as KawaiiPhysics' anim
 /// notifies do: `tassel:reset_dynamics`, `tassel:set_alpha 0.3 [chain]`,
 /// `tassel:enable_force NAME`, `tassel:disable_force NAME`, `tassel:force_once NAME` (the
-/// forces of the rig file's `[[external_force]]`). Returns 1 when it acted, 0 for an event
+/// forces of the rig file's `[[external_force]]`), `tassel:override NAME stiffness=0.5
+/// duration=2 ...` and `tassel:stop_override NAME [blend_out]` (timed settings overrides). Returns 1 when it acted, 0 for an event
 /// that does not start with `tassel:` (the game's own), -1 on error (a malformed event, a
 /// force or chain that does not exist, NULL; `tassel_last_error` says which).
 ///
@@ -456,6 +457,64 @@ pub unsafe extern "C" fn tassel_event(c: *mut TasselCharacter, event: *const c_c
         // SAFETY: the caller's promise.
         let acted = unsafe { character_mut(c) }?.flat.apply_event(event)?;
         Ok(i32::from(acted))
+    })
+}
+
+/// Starts a timed settings override of the chains (KawaiiPhysics'
+/// `StartPhysicsSettingsOverride`): `scales` points to six multipliers, in order damping,
+/// stiffness, world damping location, world damping rotation, radius, limit angle (1: no
+/// change); they act on the chain named `chain` (NULL: every chain) for `duration`
+/// seconds (`INFINITY`: until stopped), blending in over `blend_in` and out over
+/// `blend_out`, from the next frame. Up to 8 act at once (a ninth drops the oldest); they
+/// multiply. Returns the override's handle (> 0, for `tassel_stop_settings_override`), or
+/// -1 on error (a negative or non-finite scale, a duration not > 0, a chain that does not
+/// exist, NULL; `tassel_last_error` says which).
+///
+/// # Safety
+/// `c` is NULL or a live character; `scales` is NULL or points to 6 floats; `chain` is
+/// NULL or a NUL-terminated string.
+#[no_mangle]
+pub unsafe extern "C" fn tassel_start_settings_override(
+    c: *mut TasselCharacter,
+    scales: *const f32,
+    duration: f32,
+    blend_in: f32,
+    blend_out: f32,
+    chain: *const c_char,
+) -> i32 {
+    guard("tassel_start_settings_override", -1, || {
+        if scales.is_null() {
+            return Err("the scales are NULL".into());
+        }
+        let mut six = [0.0f32; 6];
+        // SAFETY: the caller's promise: 6 floats.
+        six.copy_from_slice(unsafe { std::slice::from_raw_parts(scales, 6) });
+        // SAFETY: the caller's promise.
+        let chain = unsafe { opt_str(chain, "the chain name") }?;
+        // SAFETY: the caller's promise.
+        let flat = &mut unsafe { character_mut(c) }?.flat;
+        let handle = flat.start_settings_override(six, duration, blend_in, blend_out, chain)?;
+        Ok(i32::try_from(handle).unwrap_or(i32::MAX))
+    })
+}
+
+/// Stops a settings override by the handle `tassel_start_settings_override` gave: it
+/// blends out from where it is over `blend_out` seconds (0: at once). Returns 1 when an
+/// override had the handle, 0 when none did (it ended), -1 for NULL.
+///
+/// # Safety
+/// `c` is NULL or a live character.
+#[no_mangle]
+pub unsafe extern "C" fn tassel_stop_settings_override(
+    c: *mut TasselCharacter,
+    handle: i32,
+    blend_out: f32,
+) -> i32 {
+    guard("tassel_stop_settings_override", -1, || {
+        // SAFETY: the caller's promise.
+        let flat = &mut unsafe { character_mut(c) }?.flat;
+        let known = u32::try_from(handle).is_ok_and(|h| flat.stop_settings_override(h, blend_out));
+        Ok(i32::from(known))
     })
 }
 

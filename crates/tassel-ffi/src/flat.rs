@@ -438,6 +438,39 @@ impl FlatCharacter {
         self.sim.apply_event(event).map_err(|e| e.to_string())
     }
 
+    /// Starts a timed settings override of the chains (see
+    /// [`CharacterSim::start_settings_override`]): `scales` multiply damping, stiffness,
+    /// world damping location, world damping rotation, radius and limit angle of the chain
+    /// named `chain` (`None`: every chain) for `duration` seconds (infinite: until
+    /// stopped), blending in over `blend_in` and out over `blend_out`. Returns its handle
+    /// (> 0), or an error naming a bad value or chain.
+    pub fn start_settings_override(
+        &mut self,
+        scales: [f32; 6],
+        duration: f32,
+        blend_in: f32,
+        blend_out: f32,
+        chain: Option<&str>,
+    ) -> Result<u32, String> {
+        let timing = tassel::dynamics::chain::OverrideTiming {
+            duration,
+            blend_in,
+            blend_out,
+        };
+        let scale = tassel::dynamics::chain::SettingsScale::from_array(scales);
+        self.sim
+            .start_settings_override(scale, timing, chain, None)
+            .map(|h| h.0)
+            .map_err(|e| e.to_string())
+    }
+
+    /// Stops a settings override by its handle, blending out over `blend_out` seconds (0:
+    /// at once); false when no override has it (it ended).
+    pub fn stop_settings_override(&mut self, handle: u32, blend_out: f32) -> bool {
+        self.sim
+            .stop_settings_override(tassel::dynamics::chain::OverrideHandle(handle), blend_out)
+    }
+
     /// The solvers, for Rust callers who want more than the flat API (chain tips, VRM
     /// tails, the output in model space).
     pub fn sim(&self) -> &CharacterSim {

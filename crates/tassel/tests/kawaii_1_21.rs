@@ -58,6 +58,9 @@ macro_rules! kawaii_121 {
             dt_old: $f,
             pre_comp: ($v, $q),
             accumulator: f32,
+            /// Damping, stiffness, world damping location and rotation (KawaiiPhysics'
+            /// floats), as this frame's `UpdatePhysicsSettingsOfModifyBones` set them.
+            settings: [f32; 4],
         }
 
         impl $name {
@@ -70,6 +73,12 @@ macro_rules! kawaii_121 {
                     dt_old: 1.0 / TARGET_FPS as $f,
                     pre_comp: (<$v>::ZERO, <$q>::IDENTITY),
                     accumulator: 0.0,
+                    settings: [
+                        DAMPING as f32,
+                        STIFFNESS as f32,
+                        WORLD_DAMPING_LOCATION as f32,
+                        WORLD_DAMPING_ROTATION as f32,
+                    ],
                 }
             }
 
@@ -93,6 +102,7 @@ macro_rules! kawaii_121 {
                 let h = fixed_dt as $f;
                 let exponent = (TARGET_FPS as f32 * fixed_dt) as $f;
                 let gravity_cs = inv * ($to_v)(DVec3::from(GRAVITY));
+                let [damping, stiffness, wd_location, wd_rotation] = self.settings.map(|x| x as $f);
                 for k in 0..steps {
                     let alpha = ((k + 1) as f32 / steps as f32) as $f;
                     let target: Vec<$v> = self
@@ -110,16 +120,16 @@ macro_rules! kawaii_121 {
                         let mut velocity =
                             (self.location[i] - self.prev_location[i]) / self.dt_old.max(1.0e-4);
                         self.prev_location[i] = self.location[i];
-                        velocity *= 1.0 - DAMPING as $f;
+                        velocity *= 1.0 - damping;
                         velocity += gravity_cs * h;
                         self.location[i] += velocity * h;
-                        self.location[i] += sub_move * (1.0 - WORLD_DAMPING_LOCATION as $f);
+                        self.location[i] += sub_move * (1.0 - wd_location);
                         self.location[i] += (sub_rotation * self.prev_location[i]
                             - self.prev_location[i])
-                            * (1.0 - WORLD_DAMPING_ROTATION as $f);
+                            * (1.0 - wd_rotation);
                         let base = self.location[parent] + (target[i] - target[parent]);
-                        let pull = (base - self.location[i])
-                            * (1.0 - (1.0 - STIFFNESS as $f).powf(exponent));
+                        let pull =
+                            (base - self.location[i]) * (1.0 - (1.0 - stiffness).powf(exponent));
                         self.location[i] += pull;
                     }
                     for i in 1..=BONES {
@@ -306,4 +316,257 @@ fn a_hitch_beyond_max_substeps_drops_the_time() {
         s.pose().models[BONES].translation
     });
     assert_eq!(none, before.unwrap());
+}
+
+/// KawaiiPhysics' timed settings overrides (its master branch after 1.21, read at
+/// `fb90c52`): `ResolveWindBlowEnvelope`, `EvaluateEnvelopeAlpha01`,
+/// `RequestPhysicsSettingsOverride` / `RequestStopPhysicsSettingsOverride`,
+/// `ConsumeAndAdvancePhysicsSettingsOverrides` and
+/// `ComputeEffectivePhysicsSettingsOverrideScale`, in its f32; scales in the order damping,
+/// stiffness, world damping location, world damping rotation, radius, limit angle.
+mod kp_override {
+    const KINDA_SMALL_NUMBER: f32 = 1e-4;
+    const MAX: usize = 8;
+
+    pub fn envelope(duration: f32, rise: f32, decay: f32) -> (f32, f32, f32) {
+        if duration <= 0.0 {
+            return (0.0, 0.0, 0.0);
+        }
+        let (rise, decay) = (rise.max(0.0), decay.max(0.0));
+        let edge = rise + decay;
+        if edge > duration && edge > 0.0 {
+            let scale = duration / edge;
+            return (rise * scale, 0.0, decay * scale);
+        }
+        (rise, (duration - edge).max(0.0), decay)
+    }
+
+    pub fn alpha01(rise: f32, hold: f32, decay: f32, elapsed: f32) -> f32 {
+        if elapsed < 0.0 {
+            return 0.0;
+        }
+        let (rise, hold, decay) = (rise.max(0.0), hold.max(0.0), decay.max(0.0));
+        if rise > KINDA_SMALL_NUMBER && elapsed < rise {
+            return elapsed / rise;
+        }
+        if elapsed < rise + hold {
+            return 1.0;
+        }
+        if decay <= KINDA_SMALL_NUMBER {
+            return 0.0;
+        }
+        let d = elapsed - rise - hold;
+        if d < decay {
+            return 1.0 - d / decay;
+        }
+        0.0
+    }
+
+    #[derive(Clone, Copy)]
+    struct Item {
+        scale: [f32; 6],
+        rise: f32,
+        hold: f32,
+        decay: f32,
+        elapsed: f32,
+        peak: f32,
+        handle: i64,
+    }
+
+    #[derive(Default)]
+    pub struct Node {
+        items: Vec<Item>,
+        pending: Vec<Item>,
+        stops: Vec<(i64, f32)>,
+    }
+
+    impl Node {
+        pub fn start(
+            &mut self,
+            scale: [f32; 6],
+            duration: f32,
+            blend_in: f32,
+            blend_out: f32,
+            handle: i64,
+        ) {
+            let (rise, hold, decay) = envelope(duration, blend_in, blend_out);
+            if self.pending.len() >= MAX {
+                self.pending.remove(0);
+            }
+            self.pending.push(Item {
+                scale,
+                rise,
+                hold,
+                decay,
+                elapsed: 0.0,
+                peak: 1.0,
+                handle,
+            });
+        }
+
+        pub fn stop(&mut self, handle: i64, blend_out: f32) {
+            if let Some(s) = self.stops.iter_mut().find(|s| s.0 == handle) {
+                s.1 = blend_out;
+                return;
+            }
+            self.stops.push((handle, blend_out));
+        }
+
+        pub fn consume(&mut self, dt: f32) {
+            for i in &mut self.items {
+                i.elapsed += dt;
+            }
+            self.items.append(&mut self.pending);
+            for (h, out) in std::mem::take(&mut self.stops) {
+                let mut k = self.items.len();
+                while k > 0 {
+                    k -= 1;
+                    if self.items[k].handle != h {
+                        continue;
+                    }
+                    if out <= KINDA_SMALL_NUMBER {
+                        self.items.remove(k);
+                        continue;
+                    }
+                    let it = &mut self.items[k];
+                    it.peak *= alpha01(it.rise, it.hold, it.decay, it.elapsed);
+                    it.rise = 0.0;
+                    it.hold = 0.0;
+                    it.decay = out;
+                    it.elapsed = 0.0;
+                }
+            }
+            let mut k = self.items.len();
+            while k > 0 {
+                k -= 1;
+                let it = self.items[k];
+                if it.elapsed >= it.rise + it.hold + it.decay {
+                    self.items.remove(k);
+                }
+            }
+            while self.items.len() > MAX {
+                self.items.remove(0);
+            }
+        }
+
+        pub fn effective(&self) -> [f32; 6] {
+            let mut e = [1.0f32; 6];
+            for it in &self.items {
+                let a = it.peak * alpha01(it.rise, it.hold, it.decay, it.elapsed);
+                for (x, s) in e.iter_mut().zip(it.scale) {
+                    *x *= 1.0 + a * (s - 1.0);
+                }
+            }
+            e
+        }
+    }
+}
+
+/// The overrides of the settings test: at 0.3 s a 0.8 s override (0.3 s in, 0.4 s out) of
+/// every setting the hair uses; at 0.9 s one of the chain until stopped (0.2 s in; the two
+/// multiply while both act); at 1.6 s that one stopped with 0.3 s out.
+const OVERRIDE_A: [f32; 6] = [0.3, 4.0, 0.5, 0.2, 1.0, 1.0];
+const OVERRIDE_B: [f32; 6] = [3.0, 0.5, 1.2, 1.1, 1.0, 1.0];
+
+/// `kawaii` mode with timed settings overrides against the f64 port of 1.21's update, its
+/// settings each frame from the f32 port of KawaiiPhysics' override bookkeeping: the
+/// scales equal to the bit, the joints within 2e-5 m (or twice the f32 rounding), at 30,
+/// 60 and 144 Hz; and the overrides move the hair (against the same run without them).
+#[test]
+fn kawaii_settings_overrides_match_kawaiiphysics() {
+    use tassel::dynamics::chain::{OverrideTiming, SettingsScale};
+    let sk = skeleton();
+    let rig = kawaii_rig();
+    for hz in [30u32, 60, 144] {
+        for motion in ["sway", "turn"] {
+            let mut sim = CharacterSim::new(sk.clone(), &rig).unwrap();
+            let mut plain = CharacterSim::new(sk.clone(), &rig).unwrap();
+            let mut kp = Kawaii121::new();
+            let mut kp32 = Kawaii121f32::new();
+            let mut node = kp_override::Node::default();
+            let rest = sk.rest().to_vec();
+            sim.frame(&rest, Transform::IDENTITY, 0.0).unwrap();
+            plain.frame(&rest, Transform::IDENTITY, 0.0).unwrap();
+            let (mut worst, mut rounding, mut effect) = (0.0f64, 0.0f64, 0.0f64);
+            let mut handle_b = None;
+            let mut seen = [false; 2];
+            for f in 1..=(2.4 * hz as f64) as u32 {
+                // Requests made before frame `f`, between frames.
+                if f == (0.3 * hz as f64).round() as u32 {
+                    let s = SettingsScale::from_array(OVERRIDE_A);
+                    let t = OverrideTiming {
+                        duration: 0.8,
+                        blend_in: 0.3,
+                        blend_out: 0.4,
+                    };
+                    sim.start_settings_override(s, t, None, None).unwrap();
+                    node.start(OVERRIDE_A, 0.8, 0.3, 0.4, 1);
+                }
+                if f == (0.9 * hz as f64).round() as u32 {
+                    let s = SettingsScale::from_array(OVERRIDE_B);
+                    let t = OverrideTiming {
+                        duration: f32::INFINITY,
+                        blend_in: 0.2,
+                        blend_out: 0.5,
+                    };
+                    handle_b = Some(
+                        sim.start_settings_override(s, t, Some("hair"), None)
+                            .unwrap(),
+                    );
+                    node.start(OVERRIDE_B, f32::INFINITY, 0.2, 0.5, 2);
+                }
+                if f == (1.6 * hz as f64).round() as u32 {
+                    assert!(sim.stop_settings_override(handle_b.unwrap(), 0.3));
+                    node.stop(2, 0.3);
+                }
+                let dt = 1.0 / hz as f64;
+                let t = f as f64 * dt;
+                let (pos, rot) = component(motion, t);
+                let dt32 = dt as f32;
+                node.consume(dt32);
+                let e = node.effective();
+                let settings = [
+                    (DAMPING as f32 * e[0]).clamp(0.0, 1.0),
+                    (STIFFNESS as f32 * e[1]).clamp(0.0, 1.0),
+                    (WORLD_DAMPING_LOCATION as f32 * e[2]).clamp(0.0, 1.0),
+                    (WORLD_DAMPING_ROTATION as f32 * e[3]).clamp(0.0, 1.0),
+                ];
+                kp.settings = settings;
+                kp32.settings = settings;
+                kp.frame((pos, rot), pose_at(0.0), dt32);
+                kp32.frame((pos, rot), pose_at(0.0), dt32);
+                let comp = Transform::from_translation_rotation(pos.as_vec3(), rot.as_quat());
+                sim.frame(&rest, comp, dt32).unwrap();
+                plain.frame(&rest, comp, dt32).unwrap();
+                let got = sim.settings_scale("hair").unwrap().to_array();
+                assert_eq!(got, e, "{hz} Hz frame {f}: the scales");
+                seen[0] |= e[1] > 3.9;
+                seen[1] |= e[0] > 2.9;
+                for j in 1..=BONES {
+                    let x = sim.pose().models[j].translation.as_dvec3();
+                    worst = worst.max((x - kp.joint(j)).length());
+                    rounding = rounding.max((kp32.joint(j) - kp.joint(j)).length());
+                    let y = plain.pose().models[j].translation.as_dvec3();
+                    effect = effect.max((x - y).length());
+                }
+            }
+            println!(
+                "{motion} {hz} Hz with overrides: Tassel vs the port {worst:.2e} m (f32 \
+                 rounding {rounding:.2e} m); the overrides move the hair up to {:.1} mm",
+                1e3 * effect
+            );
+            assert!(
+                seen[0] && seen[1],
+                "{hz} Hz: each override reached its full scale"
+            );
+            assert!(
+                effect > 5e-3,
+                "{hz} Hz: the overrides moved the hair {effect} m"
+            );
+            assert!(
+                worst <= 2e-5_f64.max(2.0 * rounding),
+                "{motion} {hz} Hz: {worst} m (f32 rounding alone: {rounding} m)"
+            );
+        }
+    }
 }

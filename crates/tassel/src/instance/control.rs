@@ -3,7 +3,9 @@
 //! machine's transitions (KawaiiPhysics' anim notifies).
 
 use super::CharacterSim;
-use crate::dynamics::chain::{CustomForce, ExternalForceSettings};
+use crate::dynamics::chain::{
+    CustomForce, ExternalForceSettings, OverrideHandle, OverrideTiming, SettingsScale,
+};
 use crate::error::{Error, Result};
 use std::sync::Arc;
 
@@ -93,6 +95,76 @@ impl CharacterSim {
         Ok(())
     }
 
+    /// Starts a timed settings override of the chains (KawaiiPhysics'
+    /// `StartPhysicsSettingsOverride`): `scale` multiplies the damping, stiffness, world
+    /// dampings, radius and limit angle of the chain named `chain` (`None`: every chain),
+    /// blending in and out over `timing`, from the next frame; up to
+    /// [`MAX_OVERRIDES`](crate::dynamics::chain::MAX_OVERRIDES) act at once and they
+    /// multiply. `name` (optional) lets [`stop_named_settings_override`] and the
+    /// `tassel:stop_override` event stop it; starting a name again cross-fades. Errors name
+    /// a bad scale, time or chain, or say that the character has no chains.
+    ///
+    /// [`stop_named_settings_override`]: Self::stop_named_settings_override
+    ///
+    /// ```
+    /// use tassel::dynamics::chain::{OverrideTiming, SettingsScale};
+    /// use tassel::{builtin, CharacterSim};
+    /// let c = builtin::character();
+    /// let mut sim = CharacterSim::new(c.skeleton.clone(), &c.rig).unwrap();
+    /// // Loose hair for two seconds: half the stiffness, blending in over 0.2 s.
+    /// let scale = SettingsScale { stiffness: 0.5, ..SettingsScale::ONE };
+    /// let h = sim
+    ///     .start_settings_override(scale, OverrideTiming::default(), None, None)
+    ///     .unwrap();
+    /// assert!(sim.stop_settings_override(h, 0.5));
+    /// ```
+    pub fn start_settings_override(
+        &mut self,
+        scale: SettingsScale,
+        timing: OverrideTiming,
+        chain: Option<&str>,
+        name: Option<&str>,
+    ) -> Result<OverrideHandle> {
+        let rig = Arc::clone(&self.rig);
+        if rig.chains.chain_count() == 0 {
+            return Err(Error::InvalidParameter(
+                "settings override: the character has no chains for it to act on".into(),
+            ));
+        }
+        let one;
+        let chains = match chain {
+            Some(c) => {
+                one = [rig.chain_index(c).ok_or_else(|| {
+                    Error::InvalidParameter(format!(
+                        "settings override: there is no chain named '{c}'"
+                    ))
+                })?];
+                Some(&one[..])
+            }
+            None => None,
+        };
+        self.state
+            .start_settings_override(&rig.chains, scale, timing, chains, name)
+    }
+
+    /// Stops a settings override: it blends out from where it is over `blend_out` seconds
+    /// (0: at once). False when no override has that handle (it has ended).
+    pub fn stop_settings_override(&mut self, handle: OverrideHandle, blend_out: f32) -> bool {
+        self.state.stop_settings_override(handle, blend_out)
+    }
+
+    /// Stops every settings override started with `name`; how many.
+    pub fn stop_named_settings_override(&mut self, name: &str, blend_out: f32) -> usize {
+        self.state.stop_named_settings_override(name, blend_out)
+    }
+
+    /// The settings scales of the chain named `chain` as the last frame ended (all 1 while
+    /// no override acts on it); `None` for a chain that does not exist.
+    pub fn settings_scale(&self, chain: &str) -> Option<SettingsScale> {
+        let ci = self.rig.chain_index(chain)?;
+        Some(self.state.settings_scale(&self.rig.chains, ci))
+    }
+
     /// Acts on one animation event (a state machine transition's `events` entry, see
     /// [`crate::anim::BlendPlan::events`]) that starts with `tassel:`, as KawaiiPhysics'
     /// anim notifies do:
@@ -105,6 +177,8 @@ impl CharacterSim {
     /// | `tassel:enable_force gust` | [`enable_external_force`](Self::enable_external_force) |
     /// | `tassel:disable_force gust` | turns it off |
     /// | `tassel:force_once gust` | [`external_force_once`](Self::external_force_once) |
+    /// | `tassel:override slowmo stiffness=0.5 damping=2 duration=2 blend_in=0.2 blend_out=0.5 chain=hair` | [`start_settings_override`](Self::start_settings_override) named `slowmo`: any of the six scales (`damping`, `stiffness`, `world_damping_location`, `world_damping_rotation`, `radius`, `limit_angle`; unset: 1), the times (KawaiiPhysics' 2, 0.2 and 0.5 s when unset; `duration=inf`: until stopped), the chain (unset: every chain) |
+    /// | `tassel:stop_override slowmo 0.3` | [`stop_named_settings_override`](Self::stop_named_settings_override), blending out over 0.3 s (unset: 0.5 s) |
     ///
     /// Returns `Ok(false)` for an event that does not start with `tassel:` (the game's
     /// own), `Ok(true)` when it acted, and an error naming the event when it starts with
@@ -154,10 +228,58 @@ impl CharacterSim {
                 self.external_force_once(&name)
                     .map_err(|e| bad(e.to_string()))?;
             }
+            "override" => {
+                let (name, keys) = args
+                    .split_first()
+                    .ok_or_else(|| bad("takes a name and key=value pairs".into()))?;
+                let mut scale = SettingsScale::ONE;
+                let mut timing = OverrideTiming::default();
+                let mut chain = None;
+                for kv in keys {
+                    let (k, v) = kv
+                        .split_once('=')
+                        .ok_or_else(|| bad(format!("'{kv}' is not key=value")))?;
+                    if k == "chain" {
+                        chain = Some(v);
+                        continue;
+                    }
+                    let x: f32 = v
+                        .parse()
+                        .map_err(|_| bad(format!("{k}: '{v}' is not a number")))?;
+                    match k {
+                        "duration" => timing.duration = x,
+                        "blend_in" => timing.blend_in = x,
+                        "blend_out" => timing.blend_out = x,
+                        _ if scale.set(k, x) => {}
+                        _ => {
+                            return Err(bad(format!(
+                                "'{k}' is not one of {}, duration, blend_in, blend_out, chain",
+                                SettingsScale::NAMES.join(", ")
+                            )))
+                        }
+                    }
+                }
+                self.start_settings_override(scale, timing, chain, Some(name))
+                    .map_err(|e| bad(e.to_string()))?;
+            }
+            "stop_override" => {
+                let (name, blend_out) = match args.as_slice() {
+                    [name] => (*name, 0.5),
+                    [name, t] => (
+                        *name,
+                        t.parse::<f32>()
+                            .ok()
+                            .filter(|t| t.is_finite() && *t >= 0.0)
+                            .ok_or_else(|| bad(format!("'{t}' is not a time ≥ 0")))?,
+                    ),
+                    _ => return Err(bad("takes a name and, optionally, a blend-out time".into())),
+                };
+                self.stop_named_settings_override(name, blend_out);
+            }
             _ => {
                 return Err(bad(
                     "not one of reset_dynamics, set_alpha, enable_force, disable_force, \
-                     force_once"
+                     force_once, override, stop_override"
                         .into(),
                 ))
             }

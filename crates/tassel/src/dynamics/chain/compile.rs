@@ -328,29 +328,20 @@ impl ChainRig {
             out.chain_of.resize(end, ci as u16);
             point_rest_dist.extend_from_slice(&rest_dist);
             let max_dist = rest_dist.iter().cloned().fold(0.0f32, f32::max).max(1e-6);
-            let curves = &settings.curves;
             for &d in &rest_dist {
                 let x = d / max_dist;
                 out.length_rate.push(x);
-                out.damping
-                    .push((settings.damping * curves.damping.eval(x)).clamp(0.0, 1.0));
-                out.stiffness
-                    .push((settings.stiffness * curves.stiffness.eval(x)).clamp(0.0, 1.0));
-                out.radius
-                    .push((settings.radius * curves.radius.eval(x)).max(0.0));
-                out.wd_location.push(
-                    (settings.world_damping_location * curves.world_damping_location.eval(x))
-                        .clamp(0.0, 1.0),
+                let v = super::overrides::point_settings(
+                    settings,
+                    x,
+                    &super::overrides::SettingsScale::ONE,
                 );
-                out.wd_rotation.push(
-                    (settings.world_damping_rotation * curves.world_damping_rotation.eval(x))
-                        .clamp(0.0, 1.0),
-                );
-                out.limit_angle.push(
-                    (settings.limit_angle * curves.limit_angle.eval(x))
-                        .clamp(0.0, 180.0)
-                        .to_radians(),
-                );
+                out.damping.push(v[0]);
+                out.stiffness.push(v[1]);
+                out.wd_location.push(v[2]);
+                out.wd_rotation.push(v[3]);
+                out.radius.push(v[4]);
+                out.limit_angle.push(v[5]);
             }
             let colliders = rig.collider_indices(&settings.colliders);
             pairs = pairs.saturating_add(colliders.len().saturating_mul(end - start));

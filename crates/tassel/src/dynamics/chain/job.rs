@@ -93,6 +93,9 @@ pub struct ChainState {
     last_step_base: Vec<Transform>,
     /// Scratch of a group's step: per chain, the motion its step reads ([`space_step`]).
     space_in: Vec<SpaceIn>,
+    /// Timed settings overrides, and the per-point settings they scale.
+    overrides: super::overrides::Overrides,
+    params: super::overrides::ScaledParams,
 }
 
 /// What one chain's step reads of the character's motion ([`space_step`]).
@@ -163,6 +166,8 @@ impl ChainState {
             base_prev: vec![Transform::IDENTITY; c],
             last_step_base: vec![Transform::IDENTITY; c],
             space_in: vec![(Vec3::ZERO, Quat::IDENTITY, None); c],
+            overrides: Default::default(),
+            params: super::overrides::ScaledParams::new(rig),
         }
     }
 
@@ -280,6 +285,75 @@ impl ChainState {
     /// The external forces' names, each with whether it is on.
     pub fn external_forces(&self) -> impl Iterator<Item = (&str, bool)> + '_ {
         self.forces.names()
+    }
+
+    /// Starts a timed settings override (KawaiiPhysics' `StartPhysicsSettingsOverride`):
+    /// `scale` multiplies the settings of `chains` (`None`: every chain) over `timing`,
+    /// from the next frame (in `fixed` mode, its clock starts now, between frames, and each
+    /// step reads it at its own time: the same look at every frame rate). A `name` lets
+    /// animation events stop it; starting a name again
+    /// blends the older one out over the new one's blend-in. Errors name a bad scale, time
+    /// or chain; nothing is queued then.
+    pub fn start_settings_override(
+        &mut self,
+        rig: &ChainRig,
+        scale: super::SettingsScale,
+        timing: super::OverrideTiming,
+        chains: Option<&[usize]>,
+        name: Option<&str>,
+    ) -> Result<super::OverrideHandle> {
+        self.check_rig(rig)?;
+        let chains = match chains {
+            None => None,
+            Some(list) => {
+                if let Some(&bad) = list.iter().find(|&&ci| ci >= rig.chains.len()) {
+                    return Err(Error::InvalidParameter(format!(
+                        "settings override: there is no chain {bad} (the rig has {})",
+                        rig.chains.len()
+                    )));
+                }
+                Some(list.iter().map(|&ci| ci as u16).collect())
+            }
+        };
+        self.overrides.start(scale, timing, chains, name)
+    }
+
+    /// Stops a settings override: it blends out from where it is over `blend_out` seconds
+    /// (0: at once) from the next frame. False when no override has the handle (it ended,
+    /// was dropped, or is another character's).
+    pub fn stop_settings_override(
+        &mut self,
+        handle: super::OverrideHandle,
+        blend_out: f32,
+    ) -> bool {
+        self.overrides.stop(handle, blend_out)
+    }
+
+    /// Stops every settings override started with `name`; how many.
+    pub fn stop_named_settings_override(&mut self, name: &str, blend_out: f32) -> usize {
+        self.overrides.stop_named(name, blend_out)
+    }
+
+    /// Drops every settings override at once, acting or queued.
+    pub fn clear_settings_overrides(&mut self) {
+        self.overrides.clear();
+    }
+
+    /// Chain `ci`'s settings scales as the last frame ended (all 1 while no override
+    /// acts): the product of the overrides on it, each blended by its envelope.
+    /// (`fixed` chains on their own clock, see [`ChainState::start_settings_override`].)
+    pub fn settings_scale(&self, rig: &ChainRig, ci: usize) -> super::SettingsScale {
+        if self.overrides.active() && ci < self.alpha.len() && ci < rig.chains.len() {
+            let fixed = rig.chains[ci].settings.mode == TimeMode::Fixed;
+            self.overrides.scale(ci, 0.0, fixed)
+        } else {
+            super::SettingsScale::ONE
+        }
+    }
+
+    /// How many settings overrides act (as the last frame ended).
+    pub fn settings_override_count(&self) -> usize {
+        self.overrides.len()
     }
 
     /// Sets the alpha of chain `ci` at run time, 0..=1 (multiplies its `alpha`: 0 shows
@@ -457,10 +531,15 @@ impl ChainJob<'_> {
             models,
             level,
         } = self;
-        // External forces and run-time alphas are stepped on the scalar path only (the
-        // lanes give the same bits without them).
+        // Timed settings overrides: this frame's taken in, the scaled settings on while
+        // any acts.
+        let overridden = state.overrides.advance(dt);
+        state.params.set_active(rig, overridden);
+        // External forces, run-time alphas and settings overrides are stepped on the
+        // scalar path only (the lanes give the same bits without them).
         let lanes = state.simd != SimdUse::Scalar
             && !rig.lane_groups.is_empty()
+            && !overridden
             && !state.forces.any()
             && state.alpha.iter().all(|&a| a == 1.0);
         if lanes != state.in_lanes {
@@ -690,6 +769,7 @@ fn reset_chain(
             push: &[],
             accel: &[],
             base: None,
+            params: state.params.view(rig),
         };
         step_chain(
             rig,
@@ -804,12 +884,13 @@ pub(crate) fn motion_cs(a: &Transform, b: &Transform) -> (Vec3, Quat) {
 
 /// How far any point of chain `ci` (with its radius) can be from the chain's root: its
 /// bone lengths in `targets` and radii, summed.
-fn chain_reach(rig: &ChainRig, ci: usize, targets: &[Vec3]) -> f32 {
+fn chain_reach(rig: &ChainRig, ci: usize, targets: &[Vec3], radius_scale: f32) -> f32 {
     let mut reach = 0.0f32;
     for p in rig.chains[ci].points.clone() {
         let parent = rig.parent[p];
         if parent != NONE {
-            reach += (targets[p] - targets[parent as usize]).length() + rig.radius[p];
+            reach +=
+                (targets[p] - targets[parent as usize]).length() + rig.radius[p] * radius_scale;
         }
     }
     reach
@@ -833,7 +914,9 @@ fn near_character(
         let root = chain.points.start;
         let a = state.prev_component.transform_point(state.pos[root]);
         let b = component.transform_point(state.targets[root]);
-        let margin = chain_reach(rig, ci, &state.targets) + 0.25 * (b - a).length() + 1e-2;
+        let margin = chain_reach(rig, ci, &state.targets, state.params.radius_scale(ci))
+            + 0.25 * (b - a).length()
+            + 1e-2;
         lo = lo.min(a.min(b) - margin);
         hi = hi.max(a.max(b) + margin);
     }
@@ -842,10 +925,12 @@ fn near_character(
 
 /// The world as this chain's step from `from` to `to` sees it: `None` without a level,
 /// without `world_collision`, or when no geometry is within the chain's reach.
+#[allow(clippy::too_many_arguments)]
 fn world_for<'a>(
     rig: &ChainRig,
     ci: usize,
     level: Option<&'a Level>,
+    radius_scale: f32,
     pos: &[Vec3],
     targets: &[Vec3],
     from: &Transform,
@@ -854,7 +939,7 @@ fn world_for<'a>(
     let chain = &rig.chains[ci];
     let level = level.filter(|_| chain.settings.world_collision)?;
     let root = chain.points.start;
-    let reach = chain_reach(rig, ci, targets);
+    let reach = chain_reach(rig, ci, targets, radius_scale);
     let world = WorldContact {
         level,
         from: *from,
@@ -875,6 +960,7 @@ fn run_chain(
 ) {
     let s = &rig.chains[ci].settings;
     let points = rig.chains[ci].points.clone();
+    scale_settings(rig, &[ci], state, 0.0);
     // Teleport detection on the character's own motion this frame.
     if !state.needs_reset[ci] && teleported(s, state, component) {
         state.needs_reset[ci] = true;
@@ -910,6 +996,7 @@ fn run_chain(
                         rig,
                         ci,
                         level,
+                        state.params.radius_scale(ci),
                         &state.pos,
                         &state.targets,
                         &state.prev_component,
@@ -932,6 +1019,7 @@ fn run_chain(
                         push: if forced { &state.forces.push } else { &[] },
                         accel: &state.forces.accel,
                         base,
+                        params: state.params.view(rig),
                     };
                     step_chain(
                         rig,
@@ -976,6 +1064,18 @@ fn run_chain(
 /// ends on its last step.
 pub(crate) const ON_STEP: f32 = 1e-4;
 
+/// Writes the settings of `chains` as the timed overrides scale them `back` seconds
+/// before the frame's end (nothing while none acts).
+fn scale_settings(rig: &ChainRig, chains: &[usize], state: &mut ChainState, back: f32) {
+    if state.params.active {
+        for &ci in chains {
+            let fixed = rig.chains[ci].settings.mode == TimeMode::Fixed;
+            let scale = state.overrides.scale(ci, back, fixed);
+            state.params.write(rig, ci, &scale);
+        }
+    }
+}
+
 /// Fixed mode's output points of chain `ci` in `out` (issue 63): the chain as it is at
 /// the frame's end. A frame that ends on a step outputs that step's points. Between
 /// steps, the output is the part `a` of one more step that the time left over makes
@@ -1003,6 +1103,7 @@ fn output_step(
     if left <= ON_STEP * h {
         return;
     }
+    scale_settings(rig, &[ci], state, 0.0);
     state.keep_prev[points.clone()].copy_from_slice(&state.prev[points]);
     let from = state.last_step_component[ci];
     let mut base = state.last_step_base[ci];
@@ -1016,7 +1117,16 @@ fn output_step(
         *component,
         state.base_now[ci],
     );
-    let world = world_for(rig, ci, level, &state.out, &state.targets, &from, component);
+    let world = world_for(
+        rig,
+        ci,
+        level,
+        state.params.radius_scale(ci),
+        &state.out,
+        &state.targets,
+        &from,
+        component,
+    );
     let input = StepInput {
         targets: &state.targets,
         normals: &state.normals,
@@ -1038,6 +1148,7 @@ fn output_step(
         },
         accel: &state.forces.accel,
         base,
+        params: state.params.view(rig),
     };
     let mut rng = state.rng[ci];
     step_chain(
@@ -1070,12 +1181,22 @@ fn output_step_group(
     if left <= ON_STEP * h {
         return false;
     }
+    scale_settings(rig, &group.chains, state, 0.0);
     let from = state.last_step_component[lead];
     for &ci in &group.chains {
         let points = rig.chains[ci].points.clone();
         state.keep_prev[points.clone()].copy_from_slice(&state.prev[points]);
-        state.world_near[ci] =
-            world_for(rig, ci, level, &state.out, &state.targets, &from, component).is_some();
+        state.world_near[ci] = world_for(
+            rig,
+            ci,
+            level,
+            state.params.radius_scale(ci),
+            &state.out,
+            &state.targets,
+            &from,
+            component,
+        )
+        .is_some();
     }
     for &ci in &group.chains {
         let mut base = state.last_step_base[ci];
@@ -1108,6 +1229,7 @@ fn output_step_group(
         world_near,
         forces,
         space_in,
+        params,
         ..
     } = &mut *state;
     let frame = GroupFrame {
@@ -1121,6 +1243,7 @@ fn output_step_group(
         level,
         from,
         component,
+        params: params.view(rig),
     };
     let part = left / h;
     let input_of = |ci: usize| StepInput {
@@ -1189,12 +1312,14 @@ fn output_chain(
         rig,
         ci,
         level,
+        state.params.radius_scale(ci),
         &state.targets,
         &state.targets,
         component,
         component,
     )
     .map(|w| w.level);
+    let params = state.params.view(rig);
     for p in points {
         let t = state.targets[p];
         let dev = state.dev_before[p].lerp(state.dev[p], w) * alpha;
@@ -1210,7 +1335,7 @@ fn output_chain(
             };
             // The interpolated output also respects this frame's colliders.
             let mut x = restore(t + dev);
-            let r = rig.radius[p];
+            let r = params.radius[p];
             // Broad phase (as in the step): every pass starts from a point on the sphere of
             // the bone's length about the parent's output.
             let list = &rig.chains[ci].colliders;
@@ -1327,6 +1452,7 @@ fn run_kawaii(
                 rig,
                 ci,
                 level,
+                state.params.radius_scale(ci),
                 &state.pos,
                 &state.step_targets,
                 &from,
@@ -1358,6 +1484,7 @@ fn run_kawaii(
             world_near,
             forces,
             space_in,
+            params,
             ..
         } = &mut *state;
         let frame = GroupFrame {
@@ -1371,6 +1498,7 @@ fn run_kawaii(
             level,
             from,
             component,
+            params: params.view(rig),
         };
         let input_of = |ci: usize| {
             let s = &rig.chains[ci].settings;
@@ -1438,6 +1566,7 @@ struct GroupFrame<'a> {
     level: Option<&'a Level>,
     from: Transform,
     component: &'a Transform,
+    params: super::overrides::Params<'a>,
 }
 
 impl<'a> GroupFrame<'a> {
@@ -1483,6 +1612,7 @@ impl<'a> GroupFrame<'a> {
             },
             accel: &self.forces.accel,
             base,
+            params: self.params,
         }
     }
 }
@@ -1518,6 +1648,8 @@ fn run_fixed(rig: &ChainRig, ci: usize, state: &mut ChainState, dt: f32, level: 
     let (steps, total, skipped) = fixed_steps(s, acc_old, dt);
     for k in 1..=steps {
         let w = step_end(k, h, acc_old, skipped, dt);
+        // Fixed steps read the overrides at their own time (frame-rate independent).
+        scale_settings(rig, &[ci], state, (1.0 - w) * dt);
         place_step(rig, ci, state, w);
         let comp_b = state.path.at(w);
         let base_b = state.base_prev[ci].lerp(&state.base_now[ci], w);
@@ -1536,6 +1668,7 @@ fn run_fixed(rig: &ChainRig, ci: usize, state: &mut ChainState, dt: f32, level: 
             rig,
             ci,
             level,
+            state.params.radius_scale(ci),
             &state.pos,
             &state.step_targets,
             &state.last_step_component[ci],
@@ -1558,6 +1691,7 @@ fn run_fixed(rig: &ChainRig, ci: usize, state: &mut ChainState, dt: f32, level: 
             push: if forced { &state.forces.push } else { &[] },
             accel: &state.forces.accel,
             base,
+            params: state.params.view(rig),
         };
         step_chain(
             rig,
@@ -1585,6 +1719,7 @@ fn run_group(
     let group = &rig.constraints.groups[g];
     let lead = group.chains[0];
     let s = &rig.chains[lead].settings;
+    scale_settings(rig, &group.chains, state, 0.0);
     let mut reset = group.chains.iter().any(|&ci| state.needs_reset[ci]);
     if !reset
         && group
@@ -1615,9 +1750,17 @@ fn run_group(
                 if dt > 0.0 {
                     let from = state.prev_component;
                     for &ci in &group.chains {
-                        state.world_near[ci] =
-                            world_for(rig, ci, level, &state.pos, &state.targets, &from, component)
-                                .is_some();
+                        state.world_near[ci] = world_for(
+                            rig,
+                            ci,
+                            level,
+                            state.params.radius_scale(ci),
+                            &state.pos,
+                            &state.targets,
+                            &from,
+                            component,
+                        )
+                        .is_some();
                     }
                     for &ci in &group.chains {
                         state.forces.prepare(
@@ -1646,6 +1789,7 @@ fn run_group(
                         world_near,
                         forces,
                         space_in,
+                        params,
                         ..
                     } = &mut *state;
                     let frame = GroupFrame {
@@ -1659,6 +1803,7 @@ fn run_group(
                         level,
                         from,
                         component,
+                        params: params.view(rig),
                     };
                     let input_of = |ci: usize| frame.input(rig, ci, dt, dt_old[ci], false, None);
                     step_group(
@@ -1741,8 +1886,10 @@ fn reset_group(rig: &ChainRig, group: &ChainGroup, state: &mut ChainState, compo
             normals,
             colliders,
             bounds,
+            params,
             ..
         } = &mut *state;
+        let params = params.view(rig);
         let input_of = |ci: usize| {
             let s = &rig.chains[ci].settings;
             StepInput {
@@ -1762,6 +1909,7 @@ fn reset_group(rig: &ChainRig, group: &ChainGroup, state: &mut ChainState, compo
                 push: &[],
                 accel: &[],
                 base: None,
+                params,
             }
         };
         for _ in 0..s.warmup_steps {
@@ -1805,6 +1953,7 @@ fn run_fixed_group(
     let (steps, total, skipped) = fixed_steps(s, acc_old, dt);
     for k in 1..=steps {
         let w = step_end(k, h, acc_old, skipped, dt);
+        scale_settings(rig, &group.chains, state, (1.0 - w) * dt);
         for &ci in &group.chains {
             place_step(rig, ci, state, w);
         }
@@ -1815,6 +1964,7 @@ fn run_fixed_group(
                 rig,
                 ci,
                 level,
+                state.params.radius_scale(ci),
                 &state.pos,
                 &state.step_targets,
                 &from,
@@ -1845,9 +1995,11 @@ fn run_fixed_group(
                 world_near,
                 forces,
                 space_in,
+                params,
                 ..
             } = &mut *state;
             let forces = &*forces;
+            let params = params.view(rig);
             let input_of = |ci: usize| {
                 let s = &rig.chains[ci].settings;
                 let (move_cs, rotate_cs, base) = space_in[ci];
@@ -1876,6 +2028,7 @@ fn run_fixed_group(
                     },
                     accel: &forces.accel,
                     base,
+                    params,
                 }
             };
             step_group(

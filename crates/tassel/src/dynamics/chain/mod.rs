@@ -11,6 +11,7 @@ pub(crate) mod constraint;
 pub(crate) mod force;
 pub(crate) mod job;
 pub(crate) mod lanes;
+pub(crate) mod overrides;
 mod settings;
 pub(crate) mod step;
 pub(crate) mod sync;
@@ -21,6 +22,7 @@ pub use force::{
     CurveEvaluate, CustomForce, ExternalForceSettings, ForceKind, ForcePoint, ForceSpace, ForceStep,
 };
 pub use job::{ChainJob, ChainState};
+pub use overrides::{envelope_alpha, OverrideHandle, OverrideTiming, SettingsScale, MAX_OVERRIDES};
 pub use settings::{
     ChainCurves, ChainSettings, ClassicGravity, PlanarAxis, SimulationSpace, TimeMode, Wind,
 };

@@ -48,6 +48,8 @@ pub(crate) struct StepInput<'a> {
     /// The points were carried from the first to the second; the character's turn acts
     /// on where they were (KawaiiPhysics' follow-rotation in base-bone space).
     pub base: Option<(crate::math::Transform, crate::math::Transform)>,
+    /// The per-point settings (the rig's, or scaled by timed overrides).
+    pub params: super::overrides::Params<'a>,
 }
 
 /// What one step of a chain uses for every point.
@@ -79,7 +81,6 @@ impl ChainStep {
 #[allow(clippy::too_many_arguments)]
 #[inline]
 fn advance(
-    rig: &ChainRig,
     s: &ChainSettings,
     k: &ChainStep,
     input: &StepInput,
@@ -97,7 +98,7 @@ fn advance(
         Vec3::ZERO
     };
     prev[p] = pos[p];
-    velocity *= 1.0 - rig.damping[p];
+    velocity *= 1.0 - input.params.damping[p];
     if k.wind_on {
         let gust = rng.range_f32(1.0 - s.wind.gust, 1.0 + s.wind.gust);
         let dir = if k.wind_noise > 0.0 {
@@ -114,12 +115,12 @@ fn advance(
     let mut x = pos[p] + velocity * k.moved;
 
     // Inertia: follow the character's translation and rotation only partly.
-    x += input.move_cs * (1.0 - rig.wd_location[p]);
+    x += input.move_cs * (1.0 - input.params.wd_location[p]);
     let before = match &input.base {
         Some((from, to)) => from.transform_point(to.inverse_transform_point(prev[p])),
         None => prev[p],
     };
-    x += (input.rotate_cs * before - prev[p]) * (1.0 - rig.wd_rotation[p]);
+    x += (input.rotate_cs * before - prev[p]) * (1.0 - input.params.wd_rotation[p]);
     x += k.gravity_step;
     if forced {
         x += input.push[p] * k.moved;
@@ -127,7 +128,7 @@ fn advance(
 
     // Pull toward the animated pose, relative to the simulated parent.
     let base = pos[pp] + (t[p] - t[pp]);
-    x += (base - x) * (pull(rig.stiffness[p], k.exponent) * input.part);
+    x += (base - x) * (pull(input.params.stiffness[p], k.exponent) * input.part);
     x
 }
 
@@ -149,7 +150,6 @@ impl<'a> Contact<'a> {
     #[allow(clippy::too_many_arguments)]
     #[inline]
     fn of(
-        rig: &ChainRig,
         list: &'a [usize],
         input: &'a StepInput<'a>,
         p: usize,
@@ -158,7 +158,7 @@ impl<'a> Contact<'a> {
         x: Vec3,
         from: Vec3,
     ) -> Self {
-        let r = rig.radius[p];
+        let r = input.params.radius[p];
         let near = NearSet::of(
             list,
             input.bounds,
@@ -179,7 +179,6 @@ impl<'a> Contact<'a> {
     /// current place: a group's collision and finishing passes.
     #[inline]
     fn at(
-        rig: &ChainRig,
         list: &'a [usize],
         input: &'a StepInput<'a>,
         p: usize,
@@ -189,7 +188,7 @@ impl<'a> Contact<'a> {
     ) -> Self {
         let t = input.targets;
         let length = (t[p] - t[pp]).length();
-        Self::of(rig, list, input, p, pos[pp], length, pos[p], prev[p])
+        Self::of(list, input, p, pos[pp], length, pos[p], prev[p])
     }
 
     #[inline]
@@ -209,7 +208,6 @@ impl<'a> Contact<'a> {
 #[allow(clippy::too_many_arguments)]
 #[inline]
 fn finish(
-    rig: &ChainRig,
     s: &ChainSettings,
     input: &StepInput,
     p: usize,
@@ -222,7 +220,7 @@ fn finish(
     let t = input.targets;
     // Cone limit around the animated direction.
     let anim_dir = t[p] - t[pp];
-    let limit = rig.limit_angle[p];
+    let limit = input.params.limit_angle[p];
     if limit > 0.0 {
         x = cone_limit(x, pos[pp], anim_dir, limit);
     }
@@ -289,7 +287,7 @@ pub(crate) fn step_chain(
             let anim = t[b] - t[a];
             let dir = |pos: &[Vec3]| normalize_or(pos[b] - pos[a], normalize_or(anim, Vec3::Y));
             if pp == a {
-                let x = advance(rig, s, &k, input, b, a, pos, prev, rng);
+                let x = advance(s, &k, input, b, a, pos, prev, rng);
                 pos[b] = x;
                 pos[b] = pos[a] + dir(pos) * anim.length();
             }
@@ -299,12 +297,12 @@ pub(crate) fn step_chain(
             // Stepped with the first point of its segment, above.
             pos[p]
         } else {
-            advance(rig, s, &k, input, p, pp, pos, prev, rng)
+            advance(s, &k, input, p, pp, pos, prev, rng)
         };
         let length = (t[p] - t[pp]).length();
-        let contact = Contact::of(rig, &chain.colliders, input, p, pos[pp], length, x, prev[p]);
+        let contact = Contact::of(&chain.colliders, input, p, pos[pp], length, x, prev[p]);
         let x = contact.resolve(x);
-        pos[p] = finish(rig, s, input, p, pp, x, pos, &contact, collides);
+        pos[p] = finish(s, input, p, pp, x, pos, &contact, collides);
     }
 }
 
@@ -368,7 +366,6 @@ pub(crate) fn step_group<'a>(
                 parent
             };
             pos[p] = advance(
-                rig,
                 &chain.settings,
                 &k,
                 &input,
@@ -425,7 +422,7 @@ pub(crate) fn step_group<'a>(
                 continue;
             }
             let pp = parent as usize;
-            let contact = Contact::at(rig, &chain.colliders, &input, p, pp, pos, prev);
+            let contact = Contact::at(&chain.colliders, &input, p, pp, pos, prev);
             pos[p] = contact.resolve(pos[p]);
         }
     }
@@ -443,9 +440,8 @@ pub(crate) fn step_group<'a>(
                 continue;
             }
             let pp = parent as usize;
-            let contact = Contact::at(rig, &chain.colliders, &input, p, pp, pos, prev);
+            let contact = Contact::at(&chain.colliders, &input, p, pp, pos, prev);
             pos[p] = finish(
-                rig,
                 &chain.settings,
                 &input,
                 p,
@@ -493,10 +489,12 @@ fn collide_bridges<'a>(
     let on_bridges = &rig.constraints.bridges[group.bridges.clone()];
     for (i, br) in group.bridges.clone().zip(on_bridges) {
         let (from, put) = (bridges.prev[i], bridges.pos[i]);
-        let near = NearSet::of(all, input.bounds, from.min(put), from.max(put), br.radius);
-        let mut x = near.resolve(all, input.colliders, put, Some(from), br.radius);
+        // A timed override's radius scale (its first point's chain's).
+        let r = br.radius * input.params.radius_scale[rig.chain_of[br.a as usize] as usize];
+        let near = NearSet::of(all, input.bounds, from.min(put), from.max(put), r);
+        let mut x = near.resolve(all, input.colliders, put, Some(from), r);
         if let Some((w, _)) = &world {
-            x = w.resolve(x, from, br.radius);
+            x = w.resolve(x, from, r);
         }
         bridges.pos[i] = x;
         let push = x - put;
