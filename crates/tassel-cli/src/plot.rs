@@ -1,5 +1,6 @@
 //! `tassel plot`: how far a tip strays from its animated position over time, one line per
-//! mode and frame rate, for the same motion.
+//! mode and frame rate, for the same motion; or, with `--wind NAME`, a procedural wind's
+//! parts over time (KawaiiPhysics' Wind Scope).
 
 use crate::output::{check_output_dir, write_atomic};
 use crate::subject::Mode;
@@ -29,9 +30,17 @@ pub struct Args {
     warmup: f32,
     #[command(flatten)]
     sway: SwayArgs,
-    /// Seconds plotted (default: the clip's length, or 3 s for the rest pose).
+    /// Seconds plotted (default: the clip's length, or 3 s for the rest pose; 10 s of a
+    /// wind).
     #[arg(long)]
     duration: Option<f32>,
+    /// Plot the parts of the rig's procedural wind named NAME over time instead (an
+    /// `[[external_force]]` with `kind = "procedural_wind"`): constant, sway, the ripple at
+    /// the root and at the tip, the strength cycle, the noise, the total at the root and
+    /// at the tip, sampled on the wind's own clock (its `time_scale` applied) at the first
+    /// of --rates.
+    #[arg(long, value_name = "NAME")]
+    wind: Option<String>,
     /// Output PNG.
     #[arg(short, long)]
     out: PathBuf,
@@ -48,6 +57,9 @@ pub fn run(a: Args) -> Result<(), String> {
         }
     }
     let (subject, clip) = a.subject.load()?;
+    if let Some(name) = &a.wind {
+        return plot_wind(&a, &subject, name);
+    }
     let clip = clip.map(|i| &subject.clips[i]);
     let modes = if !a.modes.is_empty() {
         a.modes.clone()
@@ -155,4 +167,98 @@ fn depth(sk: &tassel::Skeleton, mut j: usize) -> usize {
         j = p;
     }
     d
+}
+
+/// `--wind NAME`: the procedural wind's parts over `--duration` seconds (default 10).
+fn plot_wind(a: &Args, subject: &crate::subject::Subject, name: &str) -> Result<(), String> {
+    use tassel::dynamics::chain::ForceKind;
+    let force = subject
+        .rig
+        .external_forces
+        .iter()
+        .find(|f| f.name == name)
+        .ok_or_else(|| format!("--wind: the rig has no external force named '{name}'"))?;
+    if force.kind != ForceKind::ProceduralWind {
+        return Err(format!(
+            "--wind: external force '{name}' is not a procedural wind (kind = \"procedural_wind\")"
+        ));
+    }
+    force.validate().map_err(|e| e.to_string())?;
+    let duration = match a.duration {
+        Some(d) if d.is_finite() && d > 0.0 && d <= 600.0 => d,
+        Some(d) => return Err(format!("--duration {d} must be in (0, 600] seconds")),
+        None => 10.0,
+    };
+    let rate = a.rates.first().copied().unwrap_or(60.0);
+    let w = &force.procedural_wind;
+    let steps = (duration * rate).round() as usize;
+    let names = [
+        "CONSTANT",
+        "SWAY",
+        "RIPPLE ROOT",
+        "RIPPLE TIP",
+        "STRENGTH CYCLE",
+        "RANDOM",
+        "TOTAL ROOT",
+        "TOTAL TIP",
+    ];
+    let mut lines: Vec<Vec<(f32, f32)>> = vec![Vec::with_capacity(steps + 1); names.len()];
+    for k in 0..=steps {
+        let t = k as f32 / rate;
+        // The wind's own clock runs at `time_scale`.
+        let clock = t * w.time_scale;
+        let root = w.sample(clock, 0.0, 0.0, force.seed);
+        let tip = w.sample(clock, 1.0, 0.0, force.seed);
+        let values = [
+            root.constant,
+            root.sway,
+            root.ripple,
+            tip.ripple,
+            root.strength_cycle,
+            root.random,
+            root.total,
+            tip.total,
+        ];
+        for (line, v) in lines.iter_mut().zip(values) {
+            line.push((t, v));
+        }
+    }
+    let series: Vec<ChartSeries> = names
+        .iter()
+        .zip(lines)
+        .enumerate()
+        .map(|(i, (n, points))| ChartSeries {
+            name: n.to_string(),
+            color: PALETTE[i % PALETTE.len()],
+            points,
+        })
+        .collect();
+    let chart = Chart {
+        title: format!("{} - PROCEDURAL WIND {}", subject.name, name.to_uppercase()),
+        x_label: "TIME (S)".into(),
+        y_label: "WIND PARTS (PUSH UNITS) - STRENGTH CYCLE IS A MULTIPLIER".into(),
+        series,
+        bands: vec![],
+    };
+    let png = chart.draw(900, 480).png().map_err(|e| e.to_string())?;
+    write_atomic(&a.out, &png)?;
+    let range: Vec<String> = chart
+        .series
+        .iter()
+        .map(|s| {
+            let lo = s.points.iter().map(|p| p.1).fold(f32::INFINITY, f32::min);
+            let hi = s
+                .points
+                .iter()
+                .map(|p| p.1)
+                .fold(f32::NEG_INFINITY, f32::max);
+            format!("{} {lo:.3}..{hi:.3}", s.name.to_lowercase())
+        })
+        .collect();
+    say!(
+        "wrote {} (wind '{name}' over {duration} s: {})",
+        a.out.display(),
+        range.join(", ")
+    );
+    Ok(())
 }

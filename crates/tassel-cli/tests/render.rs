@@ -110,6 +110,71 @@ fn contact_sheet_draws_the_skeleton_in_every_cell() {
     assert_eq!(at(w - 3, h - 3), BG);
 }
 
+/// `tassel plot --wind NAME`: the procedural wind's parts (KawaiiPhysics' Wind Scope), one
+/// line each, their ranges printed; the strength cycle within the file's range, the
+/// constant part the file's; a name that is no procedural wind refused by name.
+#[test]
+fn plot_draws_a_procedural_winds_parts() {
+    let dir = tmp("plot_wind");
+    let out = dir.join("wind.png");
+    let rig = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../examples/rigs/hair-procedural-wind.toml");
+    let run = tassel()
+        .args(["plot", "--builtin", "--rig"])
+        .arg(&rig)
+        .args(["--wind", "breeze", "--duration", "12", "-o"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let text = String::from_utf8_lossy(&run.stdout);
+    let range = |name: &str| -> (f32, f32) {
+        let at = text
+            .find(&format!("{name} "))
+            .unwrap_or_else(|| panic!("{text}"));
+        let r = text[at + name.len() + 1..]
+            .split([',', ')'])
+            .next()
+            .unwrap();
+        let (lo, hi) = r.split_once("..").unwrap();
+        (lo.parse().unwrap(), hi.parse().unwrap())
+    };
+    assert_eq!(range("constant"), (0.15, 0.15), "{text}");
+    let (lo, hi) = range("strength cycle");
+    // A 6 s cycle over 12 s: it reaches both ends of [0.5, 1.5].
+    assert!((lo - 0.5).abs() < 0.01 && (hi - 1.5).abs() < 0.01, "{text}");
+    let (lo, hi) = range("sway");
+    assert!(
+        (lo + 0.1).abs() < 0.005 && (hi - 0.1).abs() < 0.005,
+        "{text}"
+    );
+    let (lo, hi) = range("random");
+    assert!(lo < 0.0 && hi > 0.0 && lo >= -0.08 && hi <= 0.08, "{text}");
+    let (w, h, _) = read_png(&out);
+    assert_eq!((w, h), (900, 480));
+    let forces = rig.with_file_name("hair-forces-and-spaces.toml");
+    for (file, name, needle) in [
+        (&rig, "nothing", "no external force named 'nothing'"),
+        (&forces, "breeze", "'breeze' is not a procedural wind"),
+    ] {
+        let run = tassel()
+            .args(["plot", "--builtin", "--rig"])
+            .arg(file)
+            .args(["--wind", name, "-o"])
+            .arg(dir.join("bad.png"))
+            .output()
+            .unwrap();
+        assert!(!run.status.success());
+        let err = String::from_utf8_lossy(&run.stderr);
+        assert!(err.contains(needle), "{err}");
+        assert!(!dir.join("bad.png").exists());
+    }
+}
+
 #[test]
 fn plot_draws_one_line_per_mode_and_rate() {
     let dir = tmp("plot");

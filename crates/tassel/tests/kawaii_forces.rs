@@ -24,7 +24,7 @@ use std::sync::Arc;
 use tassel::crowd::{ChainCrowd, CrowdKind};
 use tassel::dynamics::chain::{
     ChainSettings, ClassicGravity, CurveEvaluate, CustomForce, ExternalForceSettings, ForceKind,
-    ForcePoint, ForceSpace, ForceStep, TimeMode,
+    ForcePoint, ForceSpace, ForceStep, GustRequest, ProceduralWindSettings, TimeMode,
 };
 use tassel::dynamics::{Curve, RigSettings};
 use tassel::{CharacterRig, CharacterSim, Skeleton, Transform};
@@ -87,6 +87,151 @@ fn curve_value(keys: &[[f32; 4]], t: f64) -> DVec3 {
     v(keys.last().unwrap())
 }
 
+/// KawaiiPhysics' procedural wind (its master branch after 1.21, read at `fb90c52`:
+/// `KawaiiPhysicsExternalForce_ProceduralWind.cpp`): `ComputeWindSample`'s parts in its
+/// floats, `StableHash`, `NoiseValueAt` (Unreal's `FRandomStream`: the seed times
+/// 196314165 plus 907633515, the top 23 bits as a fraction), `SampleSmoothNoise`, and the
+/// direction's cone noise (`ApplyConeNoiseToDirection` with `FindBestAxisVectors`) in
+/// UE5's double vectors.
+mod kp_wind {
+    use glam::DVec3;
+    use tassel::dynamics::chain::ProceduralWindSettings;
+
+    const TWO_PI: f32 = std::f32::consts::PI * 2.0;
+
+    fn rad(deg: f32) -> f32 {
+        deg * (std::f32::consts::PI / 180.0)
+    }
+
+    pub fn hash(seed: i32, grid: i32, channel: i32) -> u32 {
+        let mut h = 0x811C9DC5u32;
+        h ^= seed as u32;
+        h = h.wrapping_mul(0x01000193);
+        h ^= grid as u32;
+        h = h.wrapping_mul(0x01000193);
+        h ^= channel as u32;
+        h = h.wrapping_mul(0x01000193);
+        h ^= h >> 16;
+        h = h.wrapping_mul(0x7FEB352D);
+        h ^= h >> 15;
+        h = h.wrapping_mul(0x846CA68B);
+        h ^= h >> 16;
+        h
+    }
+
+    fn noise_at(grid: i32, seed: i32, channel: i32) -> f32 {
+        // FRandomStream(seed).FRandRange(-1, 1): one MutateSeed, then GetFraction.
+        let mut stream = hash(seed, grid, channel);
+        stream = stream.wrapping_mul(196314165).wrapping_add(907633515);
+        let fraction = f32::from_bits(0x3F800000 | (stream >> 9)) - 1.0;
+        -1.0 + (1.0 - -1.0) * fraction
+    }
+
+    pub fn smooth(u: f32, seed: i32, channel: i32) -> f32 {
+        let g = u.floor();
+        let i = g as i32;
+        let a = u - g;
+        let s = a * a * (3.0 - 2.0 * a);
+        let (v0, v1) = (noise_at(i, seed, channel), noise_at(i + 1, seed, channel));
+        v0 + s * (v1 - v0)
+    }
+
+    /// (constant + sway, strength cycle, random) at wind time `t`.
+    pub fn shared(w: &ProceduralWindSettings, t: f32, seed: i32) -> (f32, f32, f32) {
+        let sway =
+            w.sway_force * (TWO_PI * t / w.sway_period.max(0.01) + rad(w.sway_phase_offset)).sin();
+        let [lo, hi] = w.strength_cycle_range;
+        let c = 0.5
+            * (1.0
+                + (TWO_PI * t / w.strength_cycle_period.max(0.01)
+                    + rad(w.strength_cycle_phase_offset))
+                .sin());
+        let random = w.random_force * smooth(t / w.random_force_period.max(0.01), seed, 0);
+        (w.constant_force + sway, lo + c * (hi - lo), random)
+    }
+
+    pub fn ripple(w: &ProceduralWindSettings, t: f32, rate: f32) -> f32 {
+        w.ripple_force
+            * (TWO_PI * t / w.ripple_period.max(0.01) - rad(rate * w.ripple_tip_phase_delay)
+                + rad(w.ripple_phase_offset))
+            .sin()
+    }
+
+    fn safe_normal(v: DVec3) -> DVec3 {
+        let sq = v.length_squared();
+        if sq == 1.0 {
+            v
+        } else if sq < 1e-8 {
+            DVec3::ZERO
+        } else {
+            v * (1.0 / sq.sqrt())
+        }
+    }
+
+    fn forward_or(v: DVec3) -> DVec3 {
+        let n = safe_normal(v);
+        if n.abs().max_element() <= 1e-4 {
+            DVec3::X
+        } else {
+            n
+        }
+    }
+
+    pub fn direction(w: &ProceduralWindSettings, t: f32, seed: i32) -> DVec3 {
+        let base = forward_or(w.wind_direction.as_dvec3());
+        if w.wind_direction_noise_angle <= 0.0 {
+            return base;
+        }
+        let u = t / w.wind_direction_noise_period.max(0.01);
+        let (nx, ny) = (smooth(u, seed, 1), smooth(u, seed, 2));
+        let half = rad(w.wind_direction_noise_angle.max(0.0));
+        if half <= 1e-4 {
+            return base;
+        }
+        let mut disk = DVec3::new(nx as f64, ny as f64, 0.0);
+        let len = disk.truncate().length();
+        if len <= 1e-4 {
+            return base;
+        }
+        if len > 1.0 {
+            disk /= len;
+        }
+        let n = base.abs();
+        let a = if n.z > n.x && n.z > n.y {
+            DVec3::X
+        } else {
+            DVec3::Z
+        };
+        let ax = safe_normal(a - base * a.dot(base));
+        let ay = ax.cross(base);
+        let offset = safe_normal(ax * disk.x + ay * disk.y);
+        let angle = half as f64 * len.min(1.0);
+        safe_normal(base * angle.cos() + offset * angle.sin())
+    }
+
+    /// A gust's strength at `elapsed` seconds of wind time.
+    pub fn gust(strength: f32, rise: f32, hold: f32, decay: f32, elapsed: f32) -> f32 {
+        if elapsed < 0.0 {
+            return 0.0;
+        }
+        if rise > 1e-4 && elapsed < rise {
+            return strength * (elapsed / rise);
+        }
+        if elapsed < rise + hold {
+            return strength;
+        }
+        if decay <= 1e-4 {
+            return 0.0;
+        }
+        let d = elapsed - rise - hold;
+        if d < decay {
+            strength * (1.0 - d / decay)
+        } else {
+            0.0
+        }
+    }
+}
+
 /// KawaiiPhysics 1.20's update of the hair with external forces in a float type of
 /// choice: f64 (the reference) or f32 (how far rounding alone moves the same update).
 /// `$tassel_order`: gravity added as `g·dt²` after the inertia, the order Tassel's chains
@@ -103,6 +248,14 @@ macro_rules! kawaii {
             time: f32,
             /// This frame's force, in the simulation's space (bone space: as given).
             force: $v,
+            /// Procedural wind: its clock, its gusts `(start, strength, rise, hold, decay)`,
+            /// a gust asked for, a stop asked for, this step's shared parts
+            /// `(constant + sway, strength cycle, random, gust)`.
+            wind_time: f32,
+            gusts: Vec<[f32; 5]>,
+            pending: Option<[f32; 4]>,
+            stop: Option<f32>,
+            parts: [f32; 4],
         }
 
         impl $force {
@@ -114,6 +267,34 @@ macro_rules! kawaii {
                 assert_eq!(lo, hi, "the port draws no random numbers");
                 let scale = lo as $f;
                 let f = match s.kind {
+                    ForceKind::ProceduralWind => {
+                        // ConsumePendingRequests, then the clock, then the cached parts.
+                        let w = &s.procedural_wind;
+                        let seed = s.seed as u32 as i32;
+                        if let Some([g, r, h, d]) = self.pending.take() {
+                            self.gusts = vec![[self.wind_time, g, r, h, d]];
+                        }
+                        if let Some(out) = self.stop.take() {
+                            let now = self.wind_time;
+                            if out <= 1e-4 {
+                                self.gusts.clear();
+                            }
+                            for g in &mut self.gusts {
+                                let v = kp_wind::gust(g[1], g[2], g[3], g[4], now - g[0]);
+                                *g = [now, v, 0.0, 0.0, out];
+                            }
+                        }
+                        self.wind_time += dt * w.time_scale;
+                        let t = self.wind_time;
+                        let (sines, cycle, random) = kp_wind::shared(w, t, seed);
+                        let gust = self
+                            .gusts
+                            .iter()
+                            .map(|g| kp_wind::gust(g[1], g[2], g[3], g[4], t - g[0]))
+                            .sum();
+                        self.parts = [sines, cycle, random, gust];
+                        ($to_v)(kp_wind::direction(w, t, seed))
+                    }
                     ForceKind::Basic => {
                         self.time += dt;
                         let dir = ($to_v)(s.force_dir.as_dvec3());
@@ -222,6 +403,11 @@ macro_rules! kawaii {
                             s: s.clone(),
                             time: 0.0,
                             force: <$v>::ZERO,
+                            wind_time: 0.0,
+                            gusts: Vec::new(),
+                            pending: None,
+                            stop: None,
+                            parts: [0.0; 4],
                         })
                         .collect(),
                     length_rate: from_root.iter().map(|d| d / total).collect(),
@@ -287,7 +473,20 @@ macro_rules! kawaii {
                             } else {
                                 f.force
                             };
-                            self.location[i] += force * rate * dt;
+                            // Procedural wind: the ripple at the bone's length rate, the
+                            // total in KawaiiPhysics' floats.
+                            let total = if f.s.kind == ForceKind::ProceduralWind {
+                                let [sines, cycle, random, gust] = f.parts;
+                                let r = kp_wind::ripple(
+                                    &f.s.procedural_wind,
+                                    f.wind_time,
+                                    self.length_rate[i] as f32,
+                                );
+                                ((sines + r) * cycle + random + gust) as $f
+                            } else {
+                                1.0
+                            };
+                            self.location[i] += force * total * rate * dt;
                         }
                     }
                     let base = self.location[parent] + (pose[i] - pose[parent]);
@@ -344,6 +543,37 @@ const KEYS: [[f32; 4]; 3] = [
     [0.8, 0.0, 0.0, -0.3],
 ];
 
+/// A procedural wind with every part on: a wandering direction, constant, sway, a ripple
+/// down the chain, a strength cycle, noise, its clock at 1.3×, a rate curve.
+fn procedural_wind() -> ExternalForceSettings {
+    ExternalForceSettings {
+        name: "wind".into(),
+        kind: ForceKind::ProceduralWind,
+        force_rate_by_bone_length_rate: Curve::new(vec![[0.0, 0.5], [1.0, 1.0]]),
+        seed: 7,
+        procedural_wind: ProceduralWindSettings {
+            wind_direction: Vec3::new(1.0, 0.0, 0.5),
+            wind_direction_noise_angle: 25.0,
+            wind_direction_noise_period: 0.7,
+            time_scale: 1.3,
+            constant_force: 0.3,
+            sway_force: 0.4,
+            sway_period: 0.8,
+            sway_phase_offset: 30.0,
+            ripple_force: 0.5,
+            ripple_period: 0.6,
+            ripple_phase_offset: 10.0,
+            ripple_tip_phase_delay: 150.0,
+            strength_cycle_range: [0.5, 1.5],
+            strength_cycle_period: 2.0,
+            strength_cycle_phase_offset: 0.0,
+            random_force: 0.6,
+            random_force_period: 0.3,
+        },
+        ..Default::default()
+    }
+}
+
 /// One force of each preset, space and option the port covers.
 fn cases() -> Vec<(&'static str, Vec<ExternalForceSettings>)> {
     let basic = |name: &str| ExternalForceSettings {
@@ -395,6 +625,7 @@ fn cases() -> Vec<(&'static str, Vec<ExternalForceSettings>)> {
         apply_bone_filter: vec!["hair_4".into(), "hair_5".into(), "hair_6".into()],
         ..basic("gravity")
     };
+    let wind = procedural_wind();
     let all = vec![
         world.clone(),
         pulses.clone(),
@@ -402,6 +633,7 @@ fn cases() -> Vec<(&'static str, Vec<ExternalForceSettings>)> {
         curve.clone(),
         average.clone(),
         gravity.clone(),
+        wind.clone(),
     ];
     vec![
         ("basic, world space, rate curve", vec![world]),
@@ -411,7 +643,8 @@ fn cases() -> Vec<(&'static str, Vec<ExternalForceSettings>)> {
         ("curve, component space, average", vec![average]),
         ("curve, component space, max", vec![max]),
         ("gravity, override direction, apply filter", vec![gravity]),
-        ("all six together", all),
+        ("procedural wind, every part", vec![wind]),
+        ("all seven together", all),
     ]
 }
 
@@ -434,6 +667,25 @@ fn compare(
     hz: f64,
     once: Option<usize>,
 ) -> Agreement {
+    compare_with(forces, motion, hz, once, &[])
+}
+
+/// What happens to the force named `wind` before a frame: a gust starts (`strength`,
+/// `rise`, `hold`, `decay`), or its gusts stop over a blend-out.
+#[derive(Clone, Copy)]
+enum Gusting {
+    Start(usize, [f32; 4]),
+    Stop(usize, f32),
+}
+
+/// [`compare`] with gusts of the force named `wind` started and stopped before frames.
+fn compare_with(
+    forces: &[ExternalForceSettings],
+    motion: &str,
+    hz: f64,
+    once: Option<usize>,
+    gusting: &[Gusting],
+) -> Agreement {
     let sk = skeleton();
     let mut plain =
         CharacterSim::new(sk.clone(), &rig_with(TimeMode::Classic, Vec::new())).unwrap();
@@ -452,10 +704,38 @@ fn compare(
     sim.frame(&locals_at(&sk, 0.0), Transform::IDENTITY, 0.0)
         .unwrap();
     let mut a = Agreement::default();
-    for f in 1..=120 {
+    // 120 frames; with gusts, 3.2 s.
+    let frames = if gusting.is_empty() {
+        120
+    } else {
+        120.max((3.2 * hz) as usize)
+    };
+    for f in 1..=frames {
         let t = f as f64 / hz;
         let (pos, rot) = component(motion, t);
         let on = once.is_none_or(|k| k == f);
+        for g in gusting {
+            let w = forces.iter().position(|s| s.name == "wind").unwrap();
+            match *g {
+                Gusting::Start(at, [strength, rise, hold, decay]) if at == f => {
+                    kp.forces[w].pending = Some([strength, rise, hold, decay]);
+                    kp32.forces[w].pending = Some([strength, rise, hold, decay]);
+                    let gust = GustRequest {
+                        strength,
+                        rise,
+                        hold,
+                        decay,
+                    };
+                    sim.trigger_wind_gust("wind", gust).unwrap();
+                }
+                Gusting::Stop(at, out) if at == f => {
+                    kp.forces[w].stop = Some(out);
+                    kp32.forces[w].stop = Some(out);
+                    sim.stop_wind_gusts("wind", out).unwrap();
+                }
+                _ => {}
+            }
+        }
         kp.frame((pos, rot), 1.0 / hz, t, on);
         kp32.frame((pos, rot), 1.0 / hz, t, on);
         without.frame((pos, rot), 1.0 / hz, t, false);
@@ -534,6 +814,44 @@ fn classic_matches_kawaiiphysics_1_20_external_forces() {
         }
     }
     println!("worst over every case: {worst_all:.2e} m");
+}
+
+/// Gusts of the procedural wind (KawaiiPhysics' `TriggerProceduralWindGust` and
+/// `RequestGustStop`, on the wind's clock): one that rises, holds and decays; one stopped
+/// halfway through its rise; one stopped at once — against the port, at 30, 60 and 144 Hz.
+#[test]
+fn classic_matches_kawaiiphysics_procedural_wind_gusts() {
+    let mut calm = procedural_wind();
+    calm.procedural_wind.constant_force = 0.05;
+    calm.procedural_wind.sway_force = 0.0;
+    calm.procedural_wind.ripple_force = 0.0;
+    calm.procedural_wind.random_force = 0.0;
+    let forces = vec![calm];
+    for hz in [30.0, 60.0, 144.0] {
+        let at = |s: f64| (s * hz).round() as usize;
+        let schedule = [
+            Gusting::Start(at(0.3), [2.0, 0.2, 0.3, 0.4]),
+            Gusting::Start(at(1.5), [-1.5, 0.6, 0.0, 0.2]),
+            Gusting::Stop(at(1.8), 0.25),
+            Gusting::Start(at(2.5), [1.0, 0.0, 1.0, 0.0]),
+            Gusting::Stop(at(2.9), 0.0),
+        ];
+        let with = compare_with(&forces, "sway", hz, None, &schedule);
+        let without = compare_with(&forces, "sway", hz, None, &[]);
+        let gusts = with.effect - without.effect;
+        println!(
+            "gusts, sway {hz} Hz: Tassel vs the port {:.2e} m (f32 rounding {:.2e} m); the \
+             gusts move bones up to {:.1} mm more than the calm wind",
+            with.worst,
+            with.rounding,
+            1e3 * gusts
+        );
+        assert!(with.holds(), "{hz} Hz: {} m", with.worst);
+        assert!(
+            gusts > 5e-3,
+            "{hz} Hz: the gusts moved the hair {gusts} m more"
+        );
+    }
 }
 
 /// A one-shot force (KawaiiPhysics' `AnimNotify_KawaiiPhysicsAddExternalForce`) acts on

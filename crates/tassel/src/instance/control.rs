@@ -4,7 +4,7 @@
 
 use super::CharacterSim;
 use crate::dynamics::chain::{
-    CustomForce, ExternalForceSettings, OverrideHandle, OverrideTiming, SettingsScale,
+    CustomForce, ExternalForceSettings, GustRequest, OverrideHandle, OverrideTiming, SettingsScale,
 };
 use crate::error::{Error, Result};
 use std::sync::Arc;
@@ -95,6 +95,20 @@ impl CharacterSim {
         Ok(())
     }
 
+    /// Starts a gust of the procedural wind named `name` (KawaiiPhysics'
+    /// `TriggerProceduralWindGust`): its strength rises, holds and decays on the wind's
+    /// clock and adds to the wind's total; gusts stack. Errors name a bad gust, or a force
+    /// that does not exist or is not a procedural wind.
+    pub fn trigger_wind_gust(&mut self, name: &str, gust: GustRequest) -> Result<()> {
+        self.state.trigger_wind_gust(name, gust)
+    }
+
+    /// Fades every gust of the procedural wind `name` out over `blend_out` seconds (0: at
+    /// once).
+    pub fn stop_wind_gusts(&mut self, name: &str, blend_out: f32) -> Result<()> {
+        self.state.stop_wind_gusts(name, blend_out)
+    }
+
     /// Starts a timed settings override of the chains (KawaiiPhysics'
     /// `StartPhysicsSettingsOverride`): `scale` multiplies the damping, stiffness, world
     /// dampings, radius and limit angle of the chain named `chain` (`None`: every chain),
@@ -178,6 +192,8 @@ impl CharacterSim {
     /// | `tassel:disable_force gust` | turns it off |
     /// | `tassel:force_once gust` | [`external_force_once`](Self::external_force_once) |
     /// | `tassel:override slowmo stiffness=0.5 damping=2 duration=2 blend_in=0.2 blend_out=0.5 chain=hair` | [`start_settings_override`](Self::start_settings_override) named `slowmo`: any of the six scales (`damping`, `stiffness`, `world_damping_location`, `world_damping_rotation`, `radius`, `limit_angle`; unset: 1), the times (KawaiiPhysics' 2, 0.2 and 0.5 s when unset; `duration=inf`: until stopped), the chain (unset: every chain) |
+    /// | `tassel:gust breeze strength=3 rise=0.2 hold=0.5 decay=1` | [`trigger_wind_gust`](Self::trigger_wind_gust) of the procedural wind `breeze` (unset times: 0) |
+    /// | `tassel:stop_gust breeze 0.3` | [`stop_wind_gusts`](Self::stop_wind_gusts) over 0.3 s (unset: 0.5 s) |
     /// | `tassel:stop_override slowmo 0.3` | [`stop_named_settings_override`](Self::stop_named_settings_override), blending out over 0.3 s (unset: 0.5 s) |
     ///
     /// Returns `Ok(false)` for an event that does not start with `tassel:` (the game's
@@ -262,6 +278,55 @@ impl CharacterSim {
                 self.start_settings_override(scale, timing, chain, Some(name))
                     .map_err(|e| bad(e.to_string()))?;
             }
+            "gust" => {
+                let (name, keys) = args
+                    .split_first()
+                    .ok_or_else(|| bad("takes a wind's name and key=value pairs".into()))?;
+                let mut gust = GustRequest {
+                    strength: 0.0,
+                    rise: 0.0,
+                    hold: 0.0,
+                    decay: 0.0,
+                };
+                for kv in keys {
+                    let (k, v) = kv
+                        .split_once('=')
+                        .ok_or_else(|| bad(format!("'{kv}' is not key=value")))?;
+                    let x: f32 = v
+                        .parse()
+                        .map_err(|_| bad(format!("{k}: '{v}' is not a number")))?;
+                    match k {
+                        "strength" => gust.strength = x,
+                        "rise" => gust.rise = x,
+                        "hold" => gust.hold = x,
+                        "decay" => gust.decay = x,
+                        _ => {
+                            return Err(bad(format!(
+                                "'{k}' is not one of strength, rise, hold, decay"
+                            )))
+                        }
+                    }
+                }
+                self.trigger_wind_gust(name, gust)
+                    .map_err(|e| bad(e.to_string()))?;
+            }
+            "stop_gust" => {
+                let (name, blend_out) = match args.as_slice() {
+                    [name] => (*name, 0.5),
+                    [name, t] => (
+                        *name,
+                        t.parse::<f32>()
+                            .map_err(|_| bad(format!("'{t}' is not a time")))?,
+                    ),
+                    _ => {
+                        return Err(bad(
+                            "takes a wind's name and, optionally, a blend-out time".into()
+                        ))
+                    }
+                };
+                self.stop_wind_gusts(name, blend_out)
+                    .map_err(|e| bad(e.to_string()))?;
+            }
             "stop_override" => {
                 let (name, blend_out) = match args.as_slice() {
                     [name] => (*name, 0.5),
@@ -279,7 +344,7 @@ impl CharacterSim {
             _ => {
                 return Err(bad(
                     "not one of reset_dynamics, set_alpha, enable_force, disable_force, \
-                     force_once, override, stop_override"
+                     force_once, override, stop_override, gust, stop_gust"
                         .into(),
                 ))
             }

@@ -12,6 +12,7 @@
 //! (`ApplyToVelocity`).
 
 use super::compile::{ChainRig, VIRTUAL};
+use super::wind::{GustRequest, ProceduralWindSettings, WindClock};
 use crate::dynamics::Curve;
 use crate::error::{Error, Result};
 use crate::math::Transform;
@@ -35,6 +36,9 @@ pub enum ForceKind {
     /// An acceleration added to the velocity, down or along `override_gravity_direction`
     /// (`FKawaiiPhysics_ExternalForce_Gravity`).
     Gravity,
+    /// Wind made of parts over its own clock (`procedural_wind`: constant, sway, ripple,
+    /// strength cycle, seeded noise, gusts; `FKawaiiPhysics_ExternalForce_ProceduralWind`).
+    ProceduralWind,
 }
 
 /// The space a force's vector is given in (KawaiiPhysics' `EExternalForceSpace`).
@@ -110,8 +114,12 @@ pub struct ExternalForceSettings {
     /// Each step scales the force by a random factor in `[min, max]`
     /// (`RandomForceScaleRange`; for `gravity` this is the strength).
     pub random_force_scale_range: [f32; 2],
-    /// Seed of the random factor (Tassel's: every character and run draws the same).
+    /// Seed of the random factor (Tassel's: every character and run draws the same), and
+    /// of `procedural_wind`'s noise (its low 32 bits, KawaiiPhysics' `int32 Seed`).
     pub seed: u64,
+    /// `procedural_wind`: its parts (`[external_force.procedural_wind]`).
+    #[serde(skip_serializing_if = "ProceduralWindSettings::is_default")]
+    pub procedural_wind: ProceduralWindSettings,
 }
 
 impl Default for ExternalForceSettings {
@@ -135,6 +143,7 @@ impl Default for ExternalForceSettings {
             force_rate_by_bone_length_rate: Curve::default(),
             random_force_scale_range: [1.0, 1.0],
             seed: 1,
+            procedural_wind: ProceduralWindSettings::default(),
         }
     }
 }
@@ -203,7 +212,25 @@ impl ExternalForceSettings {
         if !self.override_gravity_direction.is_finite() {
             return bad("override_gravity_direction is not finite".into());
         }
+        if self.kind != ForceKind::ProceduralWind && !self.procedural_wind.is_default() {
+            return bad("procedural_wind is for kind = \"procedural_wind\"".into());
+        }
         match self.kind {
+            ForceKind::ProceduralWind => {
+                self.procedural_wind.validate(&what)?;
+                if self.force_dir != Vec3::ZERO
+                    || self.interval != 0.0
+                    || !self.force_curve.is_empty()
+                    || self.random_force_scale_range != [1.0, 1.0]
+                {
+                    return bad(
+                        "a procedural wind takes its strength and direction from its \
+                         procedural_wind table, not force_dir, interval, force_curve or \
+                         random_force_scale_range"
+                            .into(),
+                    );
+                }
+            }
             ForceKind::Basic => {
                 if !self.force_curve.is_empty() {
                     return bad("force_curve is for kind = \"curve\"".into());
@@ -302,6 +329,7 @@ enum Kind {
     Gravity {
         dir: Vec3,
     },
+    Wind(Box<ProceduralWindSettings>),
     Custom(Arc<dyn CustomForce>),
 }
 
@@ -398,6 +426,7 @@ impl CompiledForce {
                     Vec3::NEG_Y
                 },
             },
+            ForceKind::ProceduralWind => Kind::Wind(Box::new(s.procedural_wind.clone())),
         };
         Ok(Self {
             name: s.name.clone(),
@@ -432,6 +461,8 @@ struct Clock {
     rng: SplitMix64,
     /// A one-shot force has acted on this chain.
     fired: bool,
+    /// `procedural_wind`: its own clock and gusts.
+    wind: WindClock,
 }
 
 #[derive(Debug, Clone)]
@@ -450,6 +481,7 @@ impl Active {
                 elapsed: 0.0,
                 rng: SplitMix64::new(force.seed ^ ((ci as u64) << 32) ^ 0x4B50_4652),
                 fired: false,
+                wind: WindClock::default(),
             })
             .collect();
         Self {
@@ -544,6 +576,59 @@ impl Forces {
         };
         self.insert(rig, force, true);
         true
+    }
+
+    /// Starts a gust of the named procedural wind on each chain it reaches, at that chain's
+    /// next step. `None` when there is no force of that name, `Some(false)` when it is not
+    /// a procedural wind.
+    pub(crate) fn gust(&mut self, name: &str, request: GustRequest) -> Option<bool> {
+        let a = self.named_mut(name)?;
+        if !matches!(a.force.kind, Kind::Wind(_)) {
+            return Some(false);
+        }
+        for c in &mut a.clocks {
+            c.wind.starts.push(request);
+            if c.wind.starts.len() > super::wind::MAX_GUSTS {
+                c.wind.starts.remove(0);
+            }
+        }
+        Some(true)
+    }
+
+    /// Fades every gust of the named procedural wind out over `blend_out` seconds of its
+    /// clock (0: at once), from each chain's next step; as [`Forces::gust`].
+    pub(crate) fn stop_gusts(&mut self, name: &str, blend_out: f32) -> Option<bool> {
+        let a = self.named_mut(name)?;
+        if !matches!(a.force.kind, Kind::Wind(_)) {
+            return Some(false);
+        }
+        for c in &mut a.clocks {
+            c.wind.stop = Some(blend_out);
+        }
+        Some(true)
+    }
+
+    /// The named procedural wind's parts on chain `ci` as its last step left them (its
+    /// clock's time, the sample at the root, the direction in the force's space).
+    pub(crate) fn wind_state(
+        &self,
+        name: &str,
+        ci: usize,
+    ) -> Option<(f32, super::wind::WindSample, Vec3)> {
+        let a = self
+            .list
+            .iter()
+            .find(|a| !a.one_shot && a.force.name == name)?;
+        let Kind::Wind(w) = &a.force.kind else {
+            return None;
+        };
+        let c = a.clocks.get(ci)?;
+        let gust = c.wind.gusts.iter().map(|g| g.at(c.wind.time)).sum();
+        Some((
+            c.wind.time,
+            w.sample(c.wind.time, 0.0, gust, a.force.seed),
+            w.direction(c.wind.time, a.force.seed),
+        ))
     }
 
     /// Removes the named force (not its one-shots under way); false when there is none.
@@ -667,7 +752,9 @@ impl Forces {
                 time: clock.elapsed,
                 component: *component,
             };
-            // The force this step in its own space (custom forces: per point, below).
+            // The force this step in its own space (custom forces and winds: per point,
+            // below).
+            let mut wind_step = None;
             let v = match &f.kind {
                 Kind::Basic { dir, interval } => {
                     clock.time += dt;
@@ -718,6 +805,15 @@ impl Forces {
                     value * scale
                 }
                 Kind::Gravity { dir } => *dir * scale,
+                Kind::Wind(wind) => {
+                    // Its clock and gusts; the parts every point shares (the ripple is
+                    // per point, below).
+                    let gust = clock.wind.step(dt, wind.time_scale);
+                    let t = clock.wind.time;
+                    let at_root = wind.sample(t, 0.0, gust, f.seed);
+                    wind_step = Some((at_root, wind.direction(t, f.seed), t));
+                    Vec3::ZERO
+                }
                 Kind::Custom(_) => Vec3::ZERO,
             };
             let in_cs = |v: Vec3, p: usize| -> Vec3 {
@@ -751,6 +847,14 @@ impl Forces {
                             continue;
                         }
                         v * scale
+                    }
+                    Kind::Wind(wind) => {
+                        // KawaiiPhysics' `Apply`: the ripple at the point's length rate.
+                        let (s, dir, t) = wind_step.expect("set above");
+                        let ripple = wind.ripple(t, rig.length_rate[p]);
+                        let total =
+                            (s.constant + s.sway + ripple) * s.strength_cycle + s.random + s.gust;
+                        dir * total
                     }
                     _ => v,
                 };

@@ -287,6 +287,50 @@ impl ChainState {
         self.forces.names()
     }
 
+    /// Starts a gust of the procedural wind named `name` (an `[[external_force]]` of kind
+    /// `procedural_wind`) on each chain it reaches, from that chain's next step; gusts
+    /// stack, up to [`super::MAX_GUSTS`]. Errors name a bad gust, a force that does not
+    /// exist or is not a procedural wind.
+    pub fn trigger_wind_gust(&mut self, name: &str, gust: super::GustRequest) -> Result<()> {
+        gust.check()?;
+        self.wind_result(name, |f| f.gust(name, gust))
+    }
+
+    /// Fades every gust of the procedural wind `name` out over `blend_out` seconds of its
+    /// clock (0: at once); errors as [`ChainState::trigger_wind_gust`].
+    pub fn stop_wind_gusts(&mut self, name: &str, blend_out: f32) -> Result<()> {
+        if !(blend_out.is_finite() && blend_out >= 0.0) {
+            return Err(Error::InvalidParameter(format!(
+                "stopping the gusts of '{name}': blend_out {blend_out} s is not a time ≥ 0"
+            )));
+        }
+        self.wind_result(name, |f| f.stop_gusts(name, blend_out))
+    }
+
+    fn wind_result(
+        &mut self,
+        name: &str,
+        act: impl FnOnce(&mut super::force::Forces) -> Option<bool>,
+    ) -> Result<()> {
+        match act(&mut self.forces) {
+            Some(true) => Ok(()),
+            Some(false) => Err(Error::InvalidParameter(format!(
+                "external force '{name}' is not a procedural wind"
+            ))),
+            None => Err(Error::InvalidParameter(format!(
+                "there is no external force named '{name}'"
+            ))),
+        }
+    }
+
+    /// The procedural wind `name` on chain `ci` as its last step left it: its clock's time,
+    /// its parts at the chain's root ([`super::WindSample`]) and its unit direction in the
+    /// force's space. `None` for another kind of force, a name or chain that does not
+    /// exist.
+    pub fn wind_sample(&self, name: &str, ci: usize) -> Option<(f32, super::WindSample, Vec3)> {
+        self.forces.wind_state(name, ci)
+    }
+
     /// Starts a timed settings override (KawaiiPhysics' `StartPhysicsSettingsOverride`):
     /// `scale` multiplies the settings of `chains` (`None`: every chain) over `timing`,
     /// from the next frame (in `fixed` mode, its clock starts now, between frames, and each

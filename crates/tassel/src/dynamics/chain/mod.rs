@@ -15,6 +15,7 @@ pub(crate) mod overrides;
 mod settings;
 pub(crate) mod step;
 pub(crate) mod sync;
+pub(crate) mod wind;
 
 pub use compile::{ChainRig, PointInfo};
 pub use constraint::{BoneConstraintOptions, BoneConstraintSettings, Compliance, CompliancePreset};
@@ -27,3 +28,7 @@ pub use settings::{
     ChainCurves, ChainSettings, ClassicGravity, PlanarAxis, SimulationSpace, TimeMode, Wind,
 };
 pub use sync::{SyncBoneSettings, SyncDirection, SyncTargetSettings};
+pub use wind::{
+    smooth_noise, stable_hash, GustRequest, ProceduralWindSettings, WindSample, MAX_GUSTS,
+    MIN_PERIOD,
+};
