@@ -53,6 +53,14 @@ declare class Stepped {
   /** Stops a settings override by its handle over `blendOut` seconds (0: at once): true
    *  when one had the handle. */
   stopSettingsOverride(handle: number, blendOut?: number): boolean;
+  /** This character's colliders in the world as its last update placed them (every
+   *  collider, or the rig's `[[collider_group]]` named `group`), 12 floats each: kind (0
+   *  sphere, 1 capsule, 2 tapered capsule, 3 box, 4 plane), four shape parameters, world
+   *  translation x y z, rotation quaternion x y z w. */
+  sharedColliders(group?: string | null): Float32Array;
+  /** Sets the colliders other characters share with this one (as `sharedColliders` gives
+   *  them): the chains with `use_shared_collision = true` collide with them. */
+  setSharedColliders(floats: Float32Array | number[]): void;
   dispose(): void;
 }
 

@@ -444,6 +444,49 @@ class Driver {
     return r === 1;
   }
 
+  /** This character's colliders in the world as its last update placed them (every
+   *  collider, or the rig's `[[collider_group]]` named `group`): a Float32Array of 12
+   *  floats each (kind 0 sphere / 1 capsule / 2 tapered capsule / 3 box / 4 plane, four
+   *  shape parameters, world translation x y z, rotation quaternion x y z w), for another
+   *  character's `setSharedColliders`. Throws on a group the rig does not define. */
+  sharedColliders(group = null) {
+    const x = this.tassel.x;
+    const name = this.tassel.cstring(group);
+    try {
+      const n = Number(x.tassel_shared_colliders(this.ptr, name[0], 0, 0));
+      if (n < 0) throw this.tassel.error('reading the shared colliders failed');
+      if (n === 0) return new Float32Array(0);
+      const buf = this.tassel.copyIn(new Uint8Array(n * 12 * 4));
+      try {
+        const wrote = Number(x.tassel_shared_colliders(this.ptr, name[0], buf[0], n));
+        if (wrote !== n) throw this.tassel.error('reading the shared colliders failed');
+        return new Float32Array(this.tassel.memory.buffer, buf[0], n * 12).slice();
+      } finally {
+        this.tassel.free(buf);
+      }
+    } finally {
+      this.tassel.free(name);
+    }
+  }
+
+  /** Sets the colliders other characters share with this one (12 floats each, as
+   *  `sharedColliders` gives them; empty: none): the rig's chains with
+   *  `use_shared_collision = true` collide with them from the next update. Throws on a bad
+   *  kind, shape or transform. */
+  setSharedColliders(floats) {
+    const data = floats instanceof Float32Array ? floats : new Float32Array(floats);
+    if (data.length % 12 !== 0) throw new Error(`tassel-three: ${data.length} floats are not whole colliders of 12`);
+    const n = data.length / 12;
+    const buf = n ? this.tassel.copyIn(new Uint8Array(data.buffer, data.byteOffset, data.byteLength)) : [0, 0];
+    try {
+      if (this.tassel.x.tassel_set_shared_colliders(this.ptr, buf[0], n) < 0) {
+        throw this.tassel.error('setting the shared colliders failed');
+      }
+    } finally {
+      this.tassel.free(buf);
+    }
+  }
+
   update(delta) {
     const x = this.tassel.x;
     const locals = this.locals();
@@ -563,6 +606,12 @@ class Stepped {
   startSettingsOverride(scale, options) { return this._driver.startSettingsOverride(scale, options); }
   /** Stops a settings override by its handle: true when one had it. */
   stopSettingsOverride(handle, blendOut) { return this._driver.stopSettingsOverride(handle, blendOut); }
+  /** This character's colliders in the world (a Float32Array, 12 floats each; see the
+   *  README), for another character's `setSharedColliders`. */
+  sharedColliders(group) { return this._driver.sharedColliders(group); }
+  /** Sets the colliders other characters share with this one (their chains with
+   *  `use_shared_collision` collide with them). */
+  setSharedColliders(floats) { this._driver.setSharedColliders(floats); }
   /** Frees the module's memory for this character. */
   dispose() { this._driver.dispose(); }
 }

@@ -52,9 +52,33 @@ async function runEvents() {
   ok(c.stopSettingsOverride(h, 0) === false, 'an ended override is no one\'s');
   ok(c.event('tassel:override slow stiffness=0.5 duration=1') === true, 'tassel:override acts');
   ok(c.event('tassel:stop_override slow') === true, 'tassel:stop_override acts');
+  // Shared collision: a holder's collider group handed to the chain's character.
+  const holder = await TasselCharacter.fromGLTF(r.gltf, r.data,
+    '[[collider]]\nname = "ball"\nbone = "Bone"\nshape = "sphere"\nradius = 0.5\n\n'
+    + '[[collider_group]]\nname = "prop"\ncolliders = ["ball"]\n');
+  const cape = await TasselCharacter.fromGLTF(r.gltf, r.data,
+    `[[chain]]\nname = "cape"\nroot = "${root}"\nuse_shared_collision = true\nradius = 0.1\n`);
+  ok(holder.update(1 / 60), `the holder steps: ${holder.lastError}`);
+  const shared = holder.sharedColliders('prop');
+  ok(shared.length === 12 && shared[0] === 0 && Math.abs(shared[1] - 0.5) < 1e-6,
+    `one sphere of radius 0.5: ${Array.from(shared)}`);
+  cape.setSharedColliders(shared);
+  ok(cape.update(1 / 60), `the cape steps with a shared collider: ${cape.lastError}`);
+  thrown = null;
+  try { holder.sharedColliders('sword'); } catch (e) { thrown = e.message; }
+  ok(thrown !== null && thrown.includes("'sword'"), `an unknown group is an error naming it: ${thrown}`);
+  const badKind = shared.slice();
+  badKind[0] = 9;
+  thrown = null;
+  try { cape.setSharedColliders(badKind); } catch (e) { thrown = e.message; }
+  ok(thrown !== null && thrown.includes('kind 9'), `a bad kind is an error naming it: ${thrown}`);
+  cape.setSharedColliders(new Float32Array(0));
+  ok(cape.update(1 / 60), `the cape steps after clearing: ${cape.lastError}`);
+  holder.dispose();
+  cape.dispose();
   c.dispose();
   m.dispose();
-  console.log(bad ? 'events: FAILED' : 'events: tassel:reset_dynamics acts, a game event passes, a bad one throws; settings overrides start, stop and refuse a bad scale');
+  console.log(bad ? 'events: FAILED' : 'events: tassel:reset_dynamics acts, a game event passes, a bad one throws; settings overrides start, stop and refuse a bad scale; shared colliders pass between characters');
   return bad;
 }
 failures += await runEvents();

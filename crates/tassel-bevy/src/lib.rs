@@ -52,6 +52,7 @@ mod crowd;
 mod crowd_bones;
 #[cfg(feature = "gizmos")]
 mod gizmos;
+mod shared;
 mod spawn;
 mod step;
 #[cfg(feature = "gltf")]
@@ -62,6 +63,7 @@ pub use character::{SecondaryMotion, TasselCharacter, TasselFailed};
 pub use controller::{CharacterController, TasselCollider, TasselLevel};
 #[cfg(feature = "gizmos")]
 pub use gizmos::TasselGizmosPlugin;
+pub use shared::{SharedCollisionSource, SharedCollisionTarget};
 pub use spawn::spawn_skeleton;
 pub use step::{READ_TIME, SOLVE_TIME, STEP_TIME, WRITE_TIME};
 pub use tassel;
@@ -80,9 +82,9 @@ pub mod prelude {
     #[cfg(feature = "gizmos")]
     pub use crate::TasselGizmosPlugin;
     pub use crate::{
-        CharacterController, SecondaryMotion, SimMode, TasselCharacter, TasselCollider,
-        TasselError, TasselFailed, TasselLevel, TasselModel, TasselPlugin, TasselRig,
-        TasselSystems,
+        CharacterController, SecondaryMotion, SharedCollisionSource, SharedCollisionTarget,
+        SimMode, TasselCharacter, TasselCollider, TasselError, TasselFailed, TasselLevel,
+        TasselModel, TasselPlugin, TasselRig, TasselSystems,
     };
 }
 
@@ -147,7 +149,9 @@ impl Plugin for TasselPlugin {
                     controller::sync_level.in_set(TasselSystems::Level),
                     controller::move_characters.in_set(TasselSystems::Control),
                     bind::bind_characters.in_set(TasselSystems::Bind),
-                    step::step_characters.in_set(TasselSystems::Step),
+                    (shared::hand_over_shared_colliders, step::step_characters)
+                        .chain()
+                        .in_set(TasselSystems::Step),
                 ),
             );
     }

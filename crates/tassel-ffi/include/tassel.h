@@ -194,6 +194,37 @@ int32_t tassel_stop_settings_override(TasselCharacter *c,
                                       int32_t handle,
                                       float blend_out);
 
+// This character's colliders in the world as its last frame placed them (KawaiiPhysics'
+// shared collision source): every collider (`group` NULL) or those of the rig's
+// `[[collider_group]]` named `group`, 12 floats each into `out` (the shape's kind: 0
+// sphere, 1 capsule, 2 tapered capsule, 3 box, 4 plane; four parameters: sphere radius
+// and inside 0/1, capsule radius and length, tapered capsule radius0, radius1 and length,
+// box half extents; then the world translation x y z and rotation quaternion x y z w).
+// Returns how many colliders there are, writing them only when `capacity` (in colliders)
+// holds them all (ask with `capacity` 0 and `out` NULL); -1 on error (a group the rig does
+// not define, NULL; `tassel_last_error` says which).
+//
+// # Safety
+// `c` is NULL or a live character; `group` is NULL or a NUL-terminated string; `out` is
+// NULL (with `capacity` 0) or points to `capacity × 12` floats.
+int64_t tassel_shared_colliders(const TasselCharacter *c,
+                                const char *group,
+                                float *out,
+                                size_t capacity);
+
+// Sets the colliders other characters share with this one (world space, 12 floats each as
+// `tassel_shared_colliders` writes them; `count` 0 clears them): the chains with
+// `use_shared_collision = true` collide with them from the next frame on (set them every
+// frame for colliders that move). Returns 0, or -1 on error (a bad kind, shape or
+// transform, named by index; nothing changes then).
+//
+// # Safety
+// `c` is NULL or a live character; `data` is NULL (with `count` 0) or points to
+// `count × 12` floats.
+int32_t tassel_set_shared_colliders(TasselCharacter *c,
+                                    const float *data,
+                                    size_t count);
+
 // How many joints a solver writes (the others' output is their input). 0 for NULL.
 //
 // # Safety

@@ -518,6 +518,76 @@ pub unsafe extern "C" fn tassel_stop_settings_override(
     })
 }
 
+/// This character's colliders in the world as its last frame placed them (KawaiiPhysics'
+/// shared collision source): every collider (`group` NULL) or those of the rig's
+/// `[[collider_group]]` named `group`, 12 floats each into `out` (the shape's kind: 0
+/// sphere, 1 capsule, 2 tapered capsule, 3 box, 4 plane; four parameters: sphere radius
+/// and inside 0/1, capsule radius and length, tapered capsule radius0, radius1 and length,
+/// box half extents; then the world translation x y z and rotation quaternion x y z w).
+/// Returns how many colliders there are, writing them only when `capacity` (in colliders)
+/// holds them all (ask with `capacity` 0 and `out` NULL); -1 on error (a group the rig does
+/// not define, NULL; `tassel_last_error` says which).
+///
+/// # Safety
+/// `c` is NULL or a live character; `group` is NULL or a NUL-terminated string; `out` is
+/// NULL (with `capacity` 0) or points to `capacity × 12` floats.
+#[no_mangle]
+pub unsafe extern "C" fn tassel_shared_colliders(
+    c: *const TasselCharacter,
+    group: *const c_char,
+    out: *mut f32,
+    capacity: usize,
+) -> i64 {
+    guard("tassel_shared_colliders", -1, || {
+        // SAFETY: the caller's promise.
+        let group = unsafe { opt_str(group, "the group name") }?;
+        // SAFETY: the caller's promise.
+        let flat = &unsafe { character(c) }?.flat;
+        let len = capacity
+            .checked_mul(crate::flat::FLOATS_PER_COLLIDER)
+            .ok_or("capacity is too large")?;
+        let out = if len == 0 {
+            &mut [][..]
+        } else {
+            // SAFETY: the caller's promise: `capacity × 12` floats.
+            unsafe { floats_mut(out, len, "out") }?
+        };
+        Ok(flat.shared_colliders(group, out)? as i64)
+    })
+}
+
+/// Sets the colliders other characters share with this one (world space, 12 floats each as
+/// `tassel_shared_colliders` writes them; `count` 0 clears them): the chains with
+/// `use_shared_collision = true` collide with them from the next frame on (set them every
+/// frame for colliders that move). Returns 0, or -1 on error (a bad kind, shape or
+/// transform, named by index; nothing changes then).
+///
+/// # Safety
+/// `c` is NULL or a live character; `data` is NULL (with `count` 0) or points to
+/// `count × 12` floats.
+#[no_mangle]
+pub unsafe extern "C" fn tassel_set_shared_colliders(
+    c: *mut TasselCharacter,
+    data: *const f32,
+    count: usize,
+) -> i32 {
+    guard("tassel_set_shared_colliders", -1, || {
+        let len = count
+            .checked_mul(crate::flat::FLOATS_PER_COLLIDER)
+            .ok_or("count is too large")?;
+        let data = if len == 0 {
+            &[][..]
+        } else {
+            // SAFETY: the caller's promise: `count × 12` floats.
+            unsafe { floats(data, len, "the colliders") }?
+        };
+        // SAFETY: the caller's promise.
+        let flat = &mut unsafe { character_mut(c) }?.flat;
+        flat.set_shared_colliders(data)?;
+        Ok(0)
+    })
+}
+
 /// How many joints a solver writes (the others' output is their input). 0 for NULL.
 ///
 /// # Safety

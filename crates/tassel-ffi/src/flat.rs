@@ -14,6 +14,13 @@ use tassel::{CharacterSim, Skeleton, Transform};
 /// x y z.
 pub const FLOATS_PER_JOINT: usize = 10;
 
+/// Floats per shared collider ([`FlatCharacter::shared_colliders`]): the shape's kind (0
+/// sphere, 1 capsule, 2 tapered capsule, 3 box, 4 plane), four parameters (sphere: radius,
+/// inside 0 or 1; capsule: radius, length; tapered capsule: radius0, radius1, length; box:
+/// half extents x y z; the rest 0), then the world translation x y z and rotation
+/// quaternion x y z w.
+pub const FLOATS_PER_COLLIDER: usize = 12;
+
 /// The largest rig file taken (16 MiB, as `tassel simulate`).
 pub const MAX_RIG_BYTES: usize = 16 << 20;
 
@@ -469,6 +476,94 @@ impl FlatCharacter {
     pub fn stop_settings_override(&mut self, handle: u32, blend_out: f32) -> bool {
         self.sim
             .stop_settings_override(tassel::dynamics::chain::OverrideHandle(handle), blend_out)
+    }
+
+    /// This character's colliders in the world as its last frame placed them — every
+    /// collider, or the rig's `[[collider_group]]` named `group` — as
+    /// [`FLOATS_PER_COLLIDER`] floats each into `out` (see
+    /// [`CharacterSim::shared_colliders`]). Returns how many there are; writes nothing when
+    /// `out` is too short for them all (ask with an empty `out`).
+    pub fn shared_colliders(&self, group: Option<&str>, out: &mut [f32]) -> Result<usize, String> {
+        let list = self
+            .sim
+            .shared_colliders(group)
+            .map_err(|e| e.to_string())?;
+        if out.len() < list.len() * FLOATS_PER_COLLIDER {
+            return Ok(list.len());
+        }
+        for (c, o) in list.iter().zip(out.chunks_exact_mut(FLOATS_PER_COLLIDER)) {
+            use tassel::collide::Shape;
+            let (kind, p) = match c.shape {
+                Shape::Sphere { radius, inside } => {
+                    (0.0, [radius, f32::from(u8::from(inside)), 0.0, 0.0])
+                }
+                Shape::Capsule { radius, length } => (1.0, [radius, length, 0.0, 0.0]),
+                Shape::TaperedCapsule {
+                    radius0,
+                    radius1,
+                    length,
+                } => (2.0, [radius0, radius1, length, 0.0]),
+                Shape::Box { half_extents: h } => (3.0, [h.x, h.y, h.z, 0.0]),
+                Shape::Plane => (4.0, [0.0; 4]),
+            };
+            let (t, r) = (c.transform.translation, c.transform.rotation);
+            o.copy_from_slice(&[
+                kind, p[0], p[1], p[2], p[3], t.x, t.y, t.z, r.x, r.y, r.z, r.w,
+            ]);
+        }
+        Ok(list.len())
+    }
+
+    /// Sets the colliders other characters share with this one from
+    /// [`FLOATS_PER_COLLIDER`] floats each (as [`FlatCharacter::shared_colliders`] writes
+    /// them; see [`CharacterSim::set_shared_colliders`]). An error names a collider whose
+    /// kind, shape or transform is bad; nothing changes then.
+    pub fn set_shared_colliders(&mut self, data: &[f32]) -> Result<(), String> {
+        use tassel::collide::{PlacedCollider, Shape};
+        if !data.len().is_multiple_of(FLOATS_PER_COLLIDER) {
+            return Err(format!(
+                "{} floats are not whole colliders of {FLOATS_PER_COLLIDER}",
+                data.len()
+            ));
+        }
+        let mut list = Vec::with_capacity(data.len() / FLOATS_PER_COLLIDER);
+        for (i, c) in data.chunks_exact(FLOATS_PER_COLLIDER).enumerate() {
+            let shape = match c[0] {
+                0.0 => Shape::Sphere {
+                    radius: c[1],
+                    inside: c[2] != 0.0,
+                },
+                1.0 => Shape::Capsule {
+                    radius: c[1],
+                    length: c[2],
+                },
+                2.0 => Shape::TaperedCapsule {
+                    radius0: c[1],
+                    radius1: c[2],
+                    length: c[3],
+                },
+                3.0 => Shape::Box {
+                    half_extents: Vec3::new(c[1], c[2], c[3]),
+                },
+                4.0 => Shape::Plane,
+                k => {
+                    return Err(format!(
+                        "shared collider {i}: kind {k} is not 0 (sphere), 1 (capsule), 2 \
+                         (tapered capsule), 3 (box) or 4 (plane)"
+                    ))
+                }
+            };
+            list.push(PlacedCollider {
+                shape,
+                transform: Transform::from_translation_rotation(
+                    Vec3::new(c[5], c[6], c[7]),
+                    Quat::from_xyzw(c[8], c[9], c[10], c[11]),
+                ),
+            });
+        }
+        self.sim
+            .set_shared_colliders(&list)
+            .map_err(|e| e.to_string())
     }
 
     /// The solvers, for Rust callers who want more than the flat API (chain tips, VRM

@@ -20,4 +20,4 @@ mod crowd;
 mod flat;
 
 pub use crowd::FlatCrowd;
-pub use flat::{parse_mode, FlatCharacter, FLOATS_PER_JOINT, MAX_RIG_BYTES};
+pub use flat::{parse_mode, FlatCharacter, FLOATS_PER_COLLIDER, FLOATS_PER_JOINT, MAX_RIG_BYTES};

@@ -18,6 +18,7 @@ use glam::Vec3;
 use std::sync::Arc;
 
 mod control;
+mod shared;
 pub use control::EVENT_PREFIX;
 
 /// A character ready to simulate: a shared compiled [`CharacterRig`], this character's

@@ -302,3 +302,110 @@ fn a_state_of_a_rig_with_other_bridges_is_refused() {
         assert!(err.to_string().contains("another chain rig"), "{err}");
     }
 }
+
+/// KawaiiPhysics 1.21's constraints across subdivided columns (`CollectInterBoneDummies`):
+/// with `bone_subdivision_count = 2` on the skirt's chains, each bone constraint whose two
+/// bones have points between bones below them joins those points pair by pair, at the
+/// same depth below the two bones (and the tips behind split last segments as the last
+/// pair); the pairs are the only constraints between points between bones; and they hold
+/// the columns' middles apart: with the leg kicked through the skirt the pairs' distances
+/// stray from their rest less with them than without (`auto_add_child_dummy_bone_constraint
+/// = false`).
+#[test]
+fn split_columns_are_joined_between_bones() {
+    let c = builtin::character();
+    let split = |auto: bool| {
+        let mut rig = skirt_rig(0);
+        rig.auto_add_child_dummy_bone_constraint = auto;
+        for ch in &mut rig.chains {
+            ch.bone_subdivision_count = 2;
+        }
+        rig
+    };
+    let sim = CharacterSim::new(c.skeleton.clone(), &split(true)).unwrap();
+    let chains = sim.rig().chains().clone();
+    // A point between bones: no joint, and a child (a tip has none).
+    let has_child = |p: usize| (0..chains.point_count()).any(|q| chains.point(q).parent == Some(p));
+    let between = |p: usize| chains.point(p).joint.is_none() && has_child(p);
+    // Its depth below its bone, and the bone.
+    let below = |mut p: usize| {
+        let mut depth = 0;
+        while chains.point(p).joint.is_none() {
+            p = chains.point(p).parent.unwrap();
+            depth += 1;
+        }
+        (p, depth)
+    };
+    let list: Vec<(usize, usize, f32)> = (0..chains.bone_constraint_count())
+        .map(|i| chains.bone_constraint(i).unwrap())
+        .collect();
+    let bones: Vec<(usize, usize)> = list
+        .iter()
+        .filter(|(a, b, _)| chains.point(*a).joint.is_some() && chains.point(*b).joint.is_some())
+        .map(|&(a, b, _)| (a, b))
+        .collect();
+    let pairs: Vec<(usize, usize, f32)> = list
+        .iter()
+        .copied()
+        .filter(|&(a, b, _)| between(a) || between(b))
+        .collect();
+    for &(a, b, rest) in &pairs {
+        assert!(
+            between(a) && between(b),
+            "{a}–{b}: a pair joins two points between bones"
+        );
+        let ((ra, da), (rb, db)) = (below(a), below(b));
+        assert_eq!(da, db, "{a}–{b}: at the same depth");
+        assert!(
+            bones.contains(&(ra, rb)),
+            "{a}–{b}: below a constrained pair of bones"
+        );
+        assert!(rest > 0.0);
+    }
+    // Two points on each split segment: two pairs per constrained pair of bones with a
+    // segment below each.
+    let with_below = bones
+        .iter()
+        .filter(|&&(a, b)| {
+            let split_below = |p: usize| {
+                (0..chains.point_count()).any(|q| chains.point(q).parent == Some(p) && between(q))
+            };
+            split_below(a) && split_below(b)
+        })
+        .count();
+    assert!(with_below > 0);
+    assert_eq!(pairs.len(), 2 * with_below);
+
+    // Behaviour: the kicked skirt, the pairs' stray from rest with and without.
+    let stray = |auto: bool| {
+        let mut sim = CharacterSim::new(c.skeleton.clone(), &split(auto)).unwrap();
+        let sk = c.skeleton.clone();
+        let thigh = sk.find("thigh_l").unwrap();
+        let rest = sk.rest().to_vec();
+        let (mut sum, mut n) = (0.0f64, 0usize);
+        for f in 0..=240 {
+            let t = f as f32 / 60.0;
+            let mut locals = rest.clone();
+            locals[thigh].rotation = rest[thigh].rotation
+                * Quat::from_rotation_x(-1.3 * (std::f32::consts::TAU * t).sin());
+            let dt = if f == 0 { 0.0 } else { 1.0 / 60.0 };
+            sim.frame(&locals, Transform::IDENTITY, dt).unwrap();
+            let out = sim.chain_state().output_positions();
+            for &(a, b, r) in &pairs {
+                let d = (out[a].distance(out[b]) - r) as f64;
+                sum += d * d;
+                n += 1;
+            }
+        }
+        (sum / n as f64).sqrt()
+    };
+    let (with, without) = (stray(true), stray(false));
+    println!(
+        "{} pairs across split columns: their distances stray {:.2} mm RMS from rest with \
+         them, {:.2} mm without",
+        pairs.len(),
+        1e3 * with,
+        1e3 * without
+    );
+    assert!(with < 0.8 * without, "{with} vs {without}");
+}

@@ -18,4 +18,4 @@ mod world;
 pub use curve::Curve;
 pub use mode::SimMode;
 pub(crate) use rig::CompiledCollider;
-pub use rig::{ColliderSettings, RigSettings};
+pub use rig::{ColliderGroupSettings, ColliderSettings, RigSettings};

@@ -223,6 +223,26 @@ pub struct RigSettings {
         skip_serializing_if = "Vec::is_empty"
     )]
     pub external_forces: Vec<crate::dynamics::chain::ExternalForceSettings>,
+    /// Named groups of this rig's colliders that other characters may collide with
+    /// (`[[collider_group]]`: `name`, `colliders`; see
+    /// [`crate::CharacterSim::shared_colliders`]).
+    #[serde(
+        default,
+        rename = "collider_group",
+        skip_serializing_if = "Vec::is_empty"
+    )]
+    pub collider_groups: Vec<ColliderGroupSettings>,
+}
+
+/// A named group of a rig's colliders (`[[collider_group]]`), shared with other characters
+/// by name (KawaiiPhysics' shared collision source tag).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ColliderGroupSettings {
+    /// The group's name.
+    pub name: String,
+    /// The colliders in it, by name.
+    pub colliders: Vec<String>,
 }
 
 fn one() -> u32 {
@@ -263,6 +283,7 @@ impl Default for RigSettings {
             bone_constraints: Vec::new(),
             sync_bones: Vec::new(),
             external_forces: Vec::new(),
+            collider_groups: Vec::new(),
         }
     }
 }
@@ -455,6 +476,21 @@ impl RigSettings {
         for c in &self.chains {
             c.validate()?;
             known(&format!("chain '{}'", c.name), &c.colliders)?;
+        }
+        let mut groups = std::collections::HashSet::with_capacity(self.collider_groups.len());
+        for g in &self.collider_groups {
+            if g.name.is_empty() {
+                return Err(Error::InvalidParameter(
+                    "a [[collider_group]] has no name".into(),
+                ));
+            }
+            if !groups.insert(g.name.as_str()) {
+                return Err(Error::InvalidParameter(format!(
+                    "two collider groups are named '{}'",
+                    g.name
+                )));
+            }
+            known(&format!("collider group '{}'", g.name), &g.colliders)?;
         }
         for s in &self.springs {
             s.validate()?;

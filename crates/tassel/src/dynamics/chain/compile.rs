@@ -97,6 +97,8 @@ pub struct ChainRig {
     /// The rig file's external forces.
     pub(crate) forces: Vec<std::sync::Arc<super::force::CompiledForce>>,
     pub(crate) joint_count: usize,
+    /// The rig's `[[collider_group]]`s: name and collider indices.
+    pub(crate) collider_groups: Vec<(String, Vec<usize>)>,
 }
 
 impl ChainRig {
@@ -232,10 +234,16 @@ impl ChainRig {
             length_rate: Vec::new(),
             forces: Vec::new(),
             joint_count: skeleton.len(),
+            collider_groups: Vec::new(),
         };
         // Every point's rest length from its chain's root.
         let mut point_rest_dist: Vec<f32> = Vec::new();
         out.colliders = CompiledCollider::compile_all(skeleton, rig);
+        out.collider_groups = rig
+            .collider_groups
+            .iter()
+            .map(|g| (g.name.clone(), rig.collider_indices(&g.colliders)))
+            .collect();
         let mut owner: Vec<Option<usize>> = vec![None; skeleton.len()];
         for (ci, settings) in rig.chains.iter().enumerate() {
             let root = skeleton.find(&settings.root).unwrap_or(0);
@@ -476,8 +484,8 @@ impl ChainRig {
         let table = PointTable {
             joint: &self.joint,
             parent: &self.parent,
-            real_parent: &self.real_parent,
             dummy_length: &self.dummy_length,
+            inter_alpha: &self.inter_alpha,
             radius: &self.radius,
             chain_of: &self.chain_of,
             rest: &rest,
@@ -516,10 +524,26 @@ impl ChainRig {
     /// character's, a move scale, a noisy wind or `kawaii` mode (such characters step one
     /// [`crate::CharacterSim`] each).
     pub fn needs_per_character(&self) -> bool {
-        self.has_bone_constraints()
+        self.uses_shared_collision()
+            || self.has_bone_constraints()
             || self.has_sync_bones()
             || self.has_external_forces()
             || self.chains.iter().any(CompiledChain::scalar_only)
+    }
+
+    /// Whether any chain collides with colliders other characters share
+    /// (`use_shared_collision`): then the character steps per character in crowds.
+    pub fn uses_shared_collision(&self) -> bool {
+        self.chains.iter().any(|c| c.settings.use_shared_collision)
+    }
+
+    /// The colliders of the rig's `[[collider_group]]` named `name` (indices), if there is
+    /// one.
+    pub fn collider_group(&self, name: &str) -> Option<&[usize]> {
+        self.collider_groups
+            .iter()
+            .find(|g| g.0 == name)
+            .map(|g| g.1.as_slice())
     }
 
     /// Whether any bone constraint joins this rig's chains (then its chains with
@@ -610,6 +634,18 @@ impl ChainRig {
         self.constraints.bridges.len()
     }
 
+    /// Number of bone constraints, those the rig file lists and those added for virtual
+    /// tips and between points between bones.
+    pub fn bone_constraint_count(&self) -> usize {
+        self.constraints.list.len()
+    }
+
+    /// Bone constraint `i`: its two points and their rest distance. `None` past the last.
+    pub fn bone_constraint(&self, i: usize) -> Option<(usize, usize, f32)> {
+        let c = self.constraints.list.get(i)?;
+        Some((c.a as usize, c.b as usize, c.rest))
+    }
+
     /// Bridge point `i`: the two points of its bone constraint, how far from the first
     /// toward the second it lies (0..1), and its radius. `None` past the last.
     pub fn bridge(&self, i: usize) -> Option<(usize, usize, f32, f32)> {
@@ -625,6 +661,28 @@ impl ChainRig {
     /// Number of colliders.
     pub fn collider_count(&self) -> usize {
         self.colliders.len()
+    }
+
+    /// The joint collider `c` follows.
+    pub fn collider_bone(&self, c: usize) -> usize {
+        self.colliders[c].bone
+    }
+
+    /// Collider `c` placed for its bone's world transform `bone` (scale ignored): where
+    /// it is in the world, as other characters' chains see it
+    /// ([`crate::CharacterSim::set_shared_colliders`]).
+    pub fn collider_at(&self, c: usize, bone: &crate::Transform) -> crate::collide::PlacedCollider {
+        let models = [crate::Transform::from_translation_rotation(
+            bone.translation,
+            bone.rotation,
+        )];
+        let col = &self.colliders[c];
+        let one = CompiledCollider {
+            bone: 0,
+            offset: col.offset,
+            shape: col.shape,
+        };
+        one.place(&models, None)
     }
 
     /// How many lane groups of twin chains (the same points, parameters, settings and

@@ -365,10 +365,11 @@ pub(crate) struct Constraints {
 pub(crate) struct PointTable<'a> {
     pub joint: &'a [u16],
     pub parent: &'a [u32],
-    /// The nearest ancestor point that is not a point between bones.
-    pub real_parent: &'a [u32],
     /// Virtual tips' lengths (0: not a tip).
     pub dummy_length: &'a [f32],
+    /// Per point between bones (`bone_subdivision_count`): its place on its segment (0:
+    /// not such a point).
+    pub inter_alpha: &'a [f32],
     pub chain_of: &'a [u16],
     /// Rest-pose position of every point (virtual tips included).
     pub rest: &'a [Vec3],
@@ -408,13 +409,44 @@ pub(crate) fn compile(
         compliance,
         bridged,
     };
+    // A bone's virtual tip, when it hangs from the bone itself (KawaiiPhysics 1.21 looks
+    // among the bone's children: a tip behind points between bones is joined by the
+    // pairs across the columns below instead).
     let dummy_child = |p: usize| {
         let chain = &chains[points.chain_of[p] as usize];
         chain.points.clone().find(|&c| {
-            points.real_parent[c] == p as u32
+            points.parent[c] == p as u32
                 && points.joint[c] == VIRTUAL
+                && points.inter_alpha[c] == 0.0
                 && points.dummy_length[c] > 0.0
         })
+    };
+    // The points between bones below bone point `p`, in order from it, and the virtual
+    // tip after them when they split the chain's last segment (KawaiiPhysics 1.21's
+    // `CollectInterBoneDummies`).
+    let inter_below = |p: usize| -> Vec<usize> {
+        let chain = &chains[points.chain_of[p] as usize];
+        let mut out = Vec::new();
+        let mut at = p;
+        while let Some(n) = chain
+            .points
+            .clone()
+            .find(|&c| points.parent[c] == at as u32 && points.inter_alpha[c] > 0.0)
+        {
+            out.push(n);
+            at = n;
+        }
+        if !out.is_empty() {
+            if let Some(tip) = chain.points.clone().find(|&c| {
+                points.parent[c] == at as u32
+                    && points.joint[c] == VIRTUAL
+                    && points.inter_alpha[c] == 0.0
+                    && points.dummy_length[c] > 0.0
+            }) {
+                out.push(tip);
+            }
+        }
+        out
     };
     let mut list = Vec::new();
     let mut dummies = Vec::new();
@@ -447,6 +479,16 @@ pub(crate) fn compile(
             if options.auto_add_child_dummy {
                 if let (Some(da), Some(db)) = (dummy_child(a), dummy_child(b)) {
                     dummies.push(constraint(da, db, compliance, bridged));
+                }
+                // Across subdivided columns (KawaiiPhysics 1.21's `CollectInterBoneDummies`):
+                // the points between bones below the two bones joined pair by pair (as many
+                // pairs as the shorter side has), at their rest distance, with the global
+                // compliance (1.21 gives them no other); the tips behind split last
+                // segments are the last pair.
+                let global = options.global_compliance.value();
+                let (ia, ib) = (inter_below(a), inter_below(b));
+                for (&pa, &pb) in ia.iter().zip(&ib) {
+                    dummies.push(constraint(pa, pb, global, bridged));
                 }
             }
             if list.len() + dummies.len() > crate::limits::MAX_BONE_CONSTRAINTS {

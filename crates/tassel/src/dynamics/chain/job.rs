@@ -96,6 +96,15 @@ pub struct ChainState {
     /// Timed settings overrides, and the per-point settings they scale.
     overrides: super::overrides::Overrides,
     params: super::overrides::ScaledParams,
+    /// Colliders other characters share with this one (world space; placed into this
+    /// character's space each frame after the rig's, at indices `rig.colliders.len()..`),
+    /// per chain that uses them its collider list with theirs (empty: the rig's list),
+    /// every collider's index (the bridge points'), and whether their placement of last
+    /// frame is missing (set, or their count changed).
+    shared: Vec<PlacedCollider>,
+    shared_lists: Vec<Vec<usize>>,
+    every: Vec<usize>,
+    shared_fresh: bool,
 }
 
 /// What one chain's step reads of the character's motion ([`space_step`]).
@@ -168,6 +177,10 @@ impl ChainState {
             space_in: vec![(Vec3::ZERO, Quat::IDENTITY, None); c],
             overrides: Default::default(),
             params: super::overrides::ScaledParams::new(rig),
+            shared: Vec::new(),
+            shared_lists: Vec::new(),
+            every: Vec::new(),
+            shared_fresh: false,
         }
     }
 
@@ -285,6 +298,87 @@ impl ChainState {
     /// The external forces' names, each with whether it is on.
     pub fn external_forces(&self) -> impl Iterator<Item = (&str, bool)> + '_ {
         self.forces.names()
+    }
+
+    /// Sets the colliders other characters share with this one (world space: each placed
+    /// where it is this frame, e.g. from [`crate::CharacterSim::shared_colliders`]), for
+    /// this frame and the next until set again or cleared; the chains with
+    /// `use_shared_collision` collide with them after the rig's own. Set them every frame
+    /// for colliders that move: each frame places them in the character's space and
+    /// sweeps points against their motion since the last frame (when their count stays
+    /// the same). Errors name a shape out of range or a transform that is not finite;
+    /// nothing changes then.
+    pub fn set_shared_colliders(&mut self, rig: &ChainRig, world: &[PlacedCollider]) -> Result<()> {
+        self.check_rig(rig)?;
+        if world.len() > crate::limits::MAX_COLLIDERS {
+            return Err(Error::InvalidParameter(format!(
+                "{} shared colliders, more than the limit of {}",
+                world.len(),
+                crate::limits::MAX_COLLIDERS
+            )));
+        }
+        for (i, c) in world.iter().enumerate() {
+            let what = format!("shared collider {i}");
+            c.shape.validate(&what)?;
+            let t = &c.transform;
+            if !(t.translation.is_finite() && t.rotation.is_finite())
+                || t.rotation.length() < 1e-6
+                || !t.within_limits()
+            {
+                return Err(Error::InvalidParameter(format!(
+                    "{what}: its transform is not finite (or beyond the coordinate limit)"
+                )));
+            }
+        }
+        let m = rig.colliders.len();
+        let k = world.len();
+        if k != self.shared.len() {
+            let n = m + k;
+            let placed = PlacedCollider {
+                shape: crate::collide::Shape::Plane,
+                transform: Transform::IDENTITY,
+            };
+            self.colliders.resize(n, placed);
+            self.prev_colliders.resize(n, placed);
+            self.step_colliders.resize(n, placed);
+            self.bounds.resize(n, Vec4::ZERO);
+            self.step_bounds.resize(n, Vec4::ZERO);
+            self.step_placed_at.resize(n, f32::NAN);
+            self.shared_fresh = true;
+        }
+        self.shared.clear();
+        self.shared.extend(world.iter().map(|c| PlacedCollider {
+            shape: c.shape,
+            transform: Transform::from_translation_rotation(
+                c.transform.translation,
+                c.transform.rotation.normalize(),
+            ),
+        }));
+        self.shared_lists = if k == 0 {
+            Vec::new()
+        } else {
+            rig.chains
+                .iter()
+                .map(|c| {
+                    if c.settings.use_shared_collision {
+                        c.colliders.iter().copied().chain(m..m + k).collect()
+                    } else {
+                        Vec::new()
+                    }
+                })
+                .collect()
+        };
+        self.every = if k == 0 {
+            Vec::new()
+        } else {
+            (0..m + k).collect()
+        };
+        Ok(())
+    }
+
+    /// The colliders shared with this character, as set (world space).
+    pub fn shared_colliders(&self) -> &[PlacedCollider] {
+        &self.shared
     }
 
     /// Starts a gust of the procedural wind named `name` (an `[[external_force]]` of kind
@@ -517,7 +611,7 @@ impl ChainJob<'_> {
         let state = &*self.state;
         let fits = state.pos.len() == self.rig.point_count()
             && state.accumulator.len() == self.rig.chains.len()
-            && state.colliders.len() == self.rig.colliders.len()
+            && state.colliders.len() == self.rig.colliders.len() + state.shared.len()
             && state.lanes.len() == self.rig.lane_groups.len()
             && state.lambda.len() == self.rig.constraints.list.len()
             && state.bridge_pos.len() == self.rig.constraints.bridges.len()
@@ -585,6 +679,11 @@ impl ChainJob<'_> {
             && !rig.lane_groups.is_empty()
             && !overridden
             && !state.forces.any()
+            && state
+                .shared_lists
+                .iter()
+                .enumerate()
+                .all(|(ci, l)| l.is_empty() || !rig.in_lane_group(ci))
             && state.alpha.iter().all(|&a| a == 1.0);
         if lanes != state.in_lanes {
             state.move_lanes(rig, lanes);
@@ -597,6 +696,24 @@ impl ChainJob<'_> {
             &mut state.normals,
             &mut state.colliders,
         );
+        // The colliders shared with this character, into its space.
+        let m = rig.colliders.len();
+        for (placed, world) in state.colliders[m..].iter_mut().zip(&state.shared) {
+            let t = &world.transform;
+            *placed = PlacedCollider {
+                shape: world.shape,
+                transform: Transform::from_translation_rotation(
+                    component.inverse_transform_point(t.translation),
+                    (component.rotation.inverse() * t.rotation).normalize(),
+                ),
+            };
+        }
+        if state.shared_fresh {
+            // No placement of last frame to sweep from.
+            let (now, before) = (&state.colliders[m..], &mut state.prev_colliders[m..]);
+            before.copy_from_slice(now);
+            state.shared_fresh = false;
+        }
         state.forces.gather_bones(rig, models);
         for (ci, chain) in rig.chains.iter().enumerate() {
             if let Some(b) = chain.base {
@@ -814,6 +931,8 @@ fn reset_chain(
             accel: &[],
             base: None,
             params: state.params.view(rig),
+            list: list_of(rig, &state.shared_lists, ci),
+            every: every_of(rig, &state.every),
         };
         step_chain(
             rig,
@@ -1064,6 +1183,8 @@ fn run_chain(
                         accel: &state.forces.accel,
                         base,
                         params: state.params.view(rig),
+                        list: list_of(rig, &state.shared_lists, ci),
+                        every: every_of(rig, &state.every),
                     };
                     step_chain(
                         rig,
@@ -1107,6 +1228,24 @@ fn run_chain(
 /// counts as none (the tolerance with which [`fixed_steps`] counts them): that frame
 /// ends on its last step.
 pub(crate) const ON_STEP: f32 = 1e-4;
+
+/// Chain `ci`'s collider list: the rig's, with the shared colliders when it uses them.
+fn list_of<'a>(rig: &'a ChainRig, lists: &'a [Vec<usize>], ci: usize) -> &'a [usize] {
+    match lists.get(ci) {
+        Some(l) if !l.is_empty() => l,
+        _ => &rig.chains[ci].colliders,
+    }
+}
+
+/// Every collider's index (the bridge points collide with all): the rig's, and the shared
+/// ones when any are set.
+fn every_of<'a>(rig: &'a ChainRig, every: &'a [usize]) -> &'a [usize] {
+    if every.is_empty() {
+        &rig.constraints.all_colliders
+    } else {
+        every
+    }
+}
 
 /// Writes the settings of `chains` as the timed overrides scale them `back` seconds
 /// before the frame's end (nothing while none acts).
@@ -1193,6 +1332,8 @@ fn output_step(
         accel: &state.forces.accel,
         base,
         params: state.params.view(rig),
+        list: list_of(rig, &state.shared_lists, ci),
+        every: every_of(rig, &state.every),
     };
     let mut rng = state.rng[ci];
     step_chain(
@@ -1274,6 +1415,8 @@ fn output_step_group(
         forces,
         space_in,
         params,
+        shared_lists,
+        every,
         ..
     } = &mut *state;
     let frame = GroupFrame {
@@ -1288,6 +1431,8 @@ fn output_step_group(
         from,
         component,
         params: params.view(rig),
+        lists: shared_lists,
+        every,
     };
     let part = left / h;
     let input_of = |ci: usize| StepInput {
@@ -1382,7 +1527,7 @@ fn output_chain(
             let r = params.radius[p];
             // Broad phase (as in the step): every pass starts from a point on the sphere of
             // the bone's length about the parent's output.
-            let list = &rig.chains[ci].colliders;
+            let list = list_of(rig, &state.shared_lists, ci);
             let length = anim.length();
             let near = NearSet::of(
                 list,
@@ -1424,7 +1569,15 @@ pub(crate) fn slerp_angle(a: Quat, b: Quat) -> f32 {
 /// once).
 fn place_step(rig: &ChainRig, ci: usize, state: &mut ChainState, w: f32) {
     place_targets(rig, ci, state, w);
-    for &c in &rig.chains[ci].colliders {
+    let lists = std::mem::take(&mut state.shared_lists);
+    place_step_colliders(list_of(rig, &lists, ci), state, w);
+    state.shared_lists = lists;
+}
+
+/// The colliders `list` placed `w` of the way from last frame's to this frame's (each once
+/// per step time).
+fn place_step_colliders(list: &[usize], state: &mut ChainState, w: f32) {
+    for &c in list {
         if state.step_placed_at[c].to_bits() != w.to_bits() {
             state.step_colliders[c] = state.prev_colliders[c].lerp(&state.colliders[c], w);
             state.step_bounds[c] = state.step_colliders[c].bound_sphere();
@@ -1529,6 +1682,8 @@ fn run_kawaii(
             forces,
             space_in,
             params,
+            shared_lists,
+            every,
             ..
         } = &mut *state;
         let frame = GroupFrame {
@@ -1543,6 +1698,8 @@ fn run_kawaii(
             from,
             component,
             params: params.view(rig),
+            lists: shared_lists,
+            every,
         };
         let input_of = |ci: usize| {
             let s = &rig.chains[ci].settings;
@@ -1611,6 +1768,8 @@ struct GroupFrame<'a> {
     from: Transform,
     component: &'a Transform,
     params: super::overrides::Params<'a>,
+    lists: &'a [Vec<usize>],
+    every: &'a [usize],
 }
 
 impl<'a> GroupFrame<'a> {
@@ -1618,7 +1777,7 @@ impl<'a> GroupFrame<'a> {
     /// `fixed`, taking `share` of the character's motion (`None`: all of it, untouched).
     fn input(
         &self,
-        rig: &ChainRig,
+        rig: &'a ChainRig,
         ci: usize,
         dt: f32,
         dt_old: f32,
@@ -1657,6 +1816,8 @@ impl<'a> GroupFrame<'a> {
             accel: &self.forces.accel,
             base,
             params: self.params,
+            list: list_of(rig, self.lists, ci),
+            every: every_of(rig, self.every),
         }
     }
 }
@@ -1736,6 +1897,8 @@ fn run_fixed(rig: &ChainRig, ci: usize, state: &mut ChainState, dt: f32, level: 
             accel: &state.forces.accel,
             base,
             params: state.params.view(rig),
+            list: list_of(rig, &state.shared_lists, ci),
+            every: every_of(rig, &state.every),
         };
         step_chain(
             rig,
@@ -1834,6 +1997,8 @@ fn run_group(
                         forces,
                         space_in,
                         params,
+                        shared_lists,
+                        every,
                         ..
                     } = &mut *state;
                     let frame = GroupFrame {
@@ -1848,6 +2013,8 @@ fn run_group(
                         from,
                         component,
                         params: params.view(rig),
+                        lists: shared_lists,
+                        every,
                     };
                     let input_of = |ci: usize| frame.input(rig, ci, dt, dt_old[ci], false, None);
                     step_group(
@@ -1931,6 +2098,8 @@ fn reset_group(rig: &ChainRig, group: &ChainGroup, state: &mut ChainState, compo
             colliders,
             bounds,
             params,
+            shared_lists,
+            every,
             ..
         } = &mut *state;
         let params = params.view(rig);
@@ -1954,6 +2123,8 @@ fn reset_group(rig: &ChainRig, group: &ChainGroup, state: &mut ChainState, compo
                 accel: &[],
                 base: None,
                 params,
+                list: list_of(rig, shared_lists, ci),
+                every: every_of(rig, every),
             }
         };
         for _ in 0..s.warmup_steps {
@@ -2001,6 +2172,12 @@ fn run_fixed_group(
         for &ci in &group.chains {
             place_step(rig, ci, state, w);
         }
+        if !group.bridges.is_empty() {
+            // The bridge points collide with every collider.
+            let every = std::mem::take(&mut state.every);
+            place_step_colliders(every_of(rig, &every), state, w);
+            state.every = every;
+        }
         let comp_b = state.path.at(w);
         let from = state.last_step_component[lead];
         for &ci in &group.chains {
@@ -2040,6 +2217,8 @@ fn run_fixed_group(
                 forces,
                 space_in,
                 params,
+                shared_lists,
+                every,
                 ..
             } = &mut *state;
             let forces = &*forces;
@@ -2073,6 +2252,8 @@ fn run_fixed_group(
                     accel: &forces.accel,
                     base,
                     params,
+                    list: list_of(rig, shared_lists, ci),
+                    every: every_of(rig, every),
                 }
             };
             step_group(

@@ -210,6 +210,11 @@ pub struct ChainSettings {
     /// Also keep every point `radius` out of the world (the [`crate::controller::Level`]
     /// handed to the frame), swept and sliding.
     pub world_collision: bool,
+    /// Also collide with the colliders other characters share with this one
+    /// ([`crate::CharacterSim::set_shared_colliders`]: a cape against another character's
+    /// body, hair against a held prop; KawaiiPhysics' `bUseSharedCollision`).
+    #[serde(skip_serializing_if = "is_false")]
+    pub use_shared_collision: bool,
     /// `fixed` mode: at most this many steps per frame; time beyond is dropped (hitch guard).
     pub max_steps_per_frame: u32,
     /// `classic` mode: a longer frame is clamped to this, seconds.
@@ -289,6 +294,7 @@ impl Default for ChainSettings {
             alpha: 1.0,
             colliders: Vec::new(),
             world_collision: false,
+            use_shared_collision: false,
             max_steps_per_frame: 10,
             max_delta_time: 0.1,
             max_substeps: 4,

@@ -50,6 +50,10 @@ pub(crate) struct StepInput<'a> {
     pub base: Option<(crate::math::Transform, crate::math::Transform)>,
     /// The per-point settings (the rig's, or scaled by timed overrides).
     pub params: super::overrides::Params<'a>,
+    /// The chain's colliders (indices into `colliders`: the rig's, and the shared ones
+    /// when the chain uses them), and every collider's (the bridge points').
+    pub list: &'a [usize],
+    pub every: &'a [usize],
 }
 
 /// What one step of a chain uses for every point.
@@ -267,7 +271,7 @@ pub(crate) fn step_chain(
     let s = &chain.settings;
     let k = ChainStep::of(s, input);
     let t = input.targets;
-    let collides = !chain.colliders.is_empty() || input.world.is_some();
+    let collides = !input.list.is_empty() || input.world.is_some();
     for p in chain.points.clone() {
         let parent = rig.parent[p];
         if parent == NONE {
@@ -300,7 +304,7 @@ pub(crate) fn step_chain(
             advance(s, &k, input, p, pp, pos, prev, rng)
         };
         let length = (t[p] - t[pp]).length();
-        let contact = Contact::of(&chain.colliders, input, p, pos[pp], length, x, prev[p]);
+        let contact = Contact::of(input.list, input, p, pos[pp], length, x, prev[p]);
         let x = contact.resolve(x);
         pos[p] = finish(s, input, p, pp, x, pos, &contact, collides);
     }
@@ -413,7 +417,7 @@ pub(crate) fn step_group<'a>(
     for &ci in group.chains {
         let chain = &rig.chains[ci];
         let input = input_of(ci);
-        if chain.colliders.is_empty() && input.world.is_none() {
+        if input.list.is_empty() && input.world.is_none() {
             continue;
         }
         for p in chain.points.clone() {
@@ -422,7 +426,7 @@ pub(crate) fn step_group<'a>(
                 continue;
             }
             let pp = parent as usize;
-            let contact = Contact::at(&chain.colliders, &input, p, pp, pos, prev);
+            let contact = Contact::at(input.list, &input, p, pp, pos, prev);
             pos[p] = contact.resolve(pos[p]);
         }
     }
@@ -433,14 +437,14 @@ pub(crate) fn step_group<'a>(
     for &ci in group.chains {
         let chain = &rig.chains[ci];
         let input = input_of(ci);
-        let collides = !chain.colliders.is_empty() || input.world.is_some();
+        let collides = !input.list.is_empty() || input.world.is_some();
         for p in chain.points.clone() {
             let parent = rig.parent[p];
             if parent == NONE {
                 continue;
             }
             let pp = parent as usize;
-            let contact = Contact::at(&chain.colliders, &input, p, pp, pos, prev);
+            let contact = Contact::at(input.list, &input, p, pp, pos, prev);
             pos[p] = finish(
                 &chain.settings,
                 &input,
@@ -484,7 +488,7 @@ fn collide_bridges<'a>(
         .chains
         .iter()
         .find_map(|&ci| input_of(ci).world.map(|w| (w, ci)));
-    let all = &rig.constraints.all_colliders;
+    let all = input.every;
     let scale = rig.constraints.feedback_scale * part;
     let on_bridges = &rig.constraints.bridges[group.bridges.clone()];
     for (i, br) in group.bridges.clone().zip(on_bridges) {

@@ -304,6 +304,7 @@ fn one_chain(rig: &ChainRig, ci: usize) -> ChainRig {
         scalar_rotators: Vec::new(),
         chain_in_lanes: Vec::new(),
         joint_count: rig.joint_count(),
+        collider_groups: Vec::new(),
     }
 }
 
