@@ -72,16 +72,9 @@ fn place_source(
     out: &mut Vec<PlacedCollider>,
 ) -> Result<(), String> {
     let chains = c.rig().chains();
-    let all: Vec<usize>;
-    let list = match &source.group {
-        Some(g) => chains.collider_group(g).ok_or_else(|| {
-            format!("SharedCollisionSource: the rig has no collider group named '{g}'")
-        })?,
-        None => {
-            all = (0..chains.collider_count()).collect();
-            &all
-        }
-    };
+    let list = chains
+        .shared_set(source.group.as_deref())
+        .map_err(|e| format!("SharedCollisionSource: {e}"))?;
     for &k in list {
         let bone = chains.collider_bone(k);
         // (A collider whose bone has no entity is not shared.)

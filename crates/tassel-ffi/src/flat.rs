@@ -484,34 +484,41 @@ impl FlatCharacter {
     /// [`CharacterSim::shared_colliders`]). Returns how many there are; writes nothing when
     /// `out` is too short for them all (ask with an empty `out`).
     pub fn shared_colliders(&self, group: Option<&str>, out: &mut [f32]) -> Result<usize, String> {
-        let list = self
+        use tassel::collide::Shape;
+        let count = self
             .sim
-            .shared_colliders(group)
-            .map_err(|e| e.to_string())?;
-        if out.len() < list.len() * FLOATS_PER_COLLIDER {
-            return Ok(list.len());
+            .rig()
+            .chains()
+            .shared_set(group)
+            .map_err(|e| e.to_string())?
+            .len();
+        if out.len() < count * FLOATS_PER_COLLIDER {
+            return Ok(count);
         }
-        for (c, o) in list.iter().zip(out.chunks_exact_mut(FLOATS_PER_COLLIDER)) {
-            use tassel::collide::Shape;
-            let (kind, p) = match c.shape {
-                Shape::Sphere { radius, inside } => {
-                    (0.0, [radius, f32::from(u8::from(inside)), 0.0, 0.0])
+        let mut slots = out.chunks_exact_mut(FLOATS_PER_COLLIDER);
+        self.sim
+            .visit_shared_colliders(group, |c| {
+                let (kind, p) = match c.shape {
+                    Shape::Sphere { radius, inside } => {
+                        (0.0, [radius, f32::from(u8::from(inside)), 0.0, 0.0])
+                    }
+                    Shape::Capsule { radius, length } => (1.0, [radius, length, 0.0, 0.0]),
+                    Shape::TaperedCapsule {
+                        radius0,
+                        radius1,
+                        length,
+                    } => (2.0, [radius0, radius1, length, 0.0]),
+                    Shape::Box { half_extents: h } => (3.0, [h.x, h.y, h.z, 0.0]),
+                    Shape::Plane => (4.0, [0.0; 4]),
+                };
+                let (t, r) = (c.transform.translation, c.transform.rotation);
+                if let Some(o) = slots.next() {
+                    o.copy_from_slice(&[
+                        kind, p[0], p[1], p[2], p[3], t.x, t.y, t.z, r.x, r.y, r.z, r.w,
+                    ]);
                 }
-                Shape::Capsule { radius, length } => (1.0, [radius, length, 0.0, 0.0]),
-                Shape::TaperedCapsule {
-                    radius0,
-                    radius1,
-                    length,
-                } => (2.0, [radius0, radius1, length, 0.0]),
-                Shape::Box { half_extents: h } => (3.0, [h.x, h.y, h.z, 0.0]),
-                Shape::Plane => (4.0, [0.0; 4]),
-            };
-            let (t, r) = (c.transform.translation, c.transform.rotation);
-            o.copy_from_slice(&[
-                kind, p[0], p[1], p[2], p[3], t.x, t.y, t.z, r.x, r.y, r.z, r.w,
-            ]);
-        }
-        Ok(list.len())
+            })
+            .map_err(|e| e.to_string())
     }
 
     /// Sets the colliders other characters share with this one from

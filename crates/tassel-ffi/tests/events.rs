@@ -5,9 +5,10 @@
 
 mod common;
 
-use std::ffi::{CStr, CString};
+use common::last_error;
+use std::ffi::CString;
 use tassel_ffi::abi::{
-    tassel_character_free, tassel_character_load, tassel_event, tassel_frame, tassel_last_error,
+    tassel_character_free, tassel_character_load, tassel_event, tassel_frame,
     tassel_start_settings_override, tassel_stop_settings_override,
 };
 use tassel_ffi::{FlatCharacter, FLOATS_PER_JOINT};
@@ -41,13 +42,6 @@ fn root(f: usize) -> [f32; F] {
         1.0,
         1.0,
     ]
-}
-
-fn last_error() -> String {
-    // SAFETY: NULL or this thread's NUL-terminated error.
-    let p = tassel_last_error();
-    assert!(!p.is_null());
-    unsafe { CStr::from_ptr(p) }.to_string_lossy().into_owned()
 }
 
 #[test]

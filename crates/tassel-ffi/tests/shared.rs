@@ -6,23 +6,17 @@
 
 mod common;
 
-use std::ffi::{CStr, CString};
+use common::last_error;
+use std::ffi::CString;
 use tassel::collide::Shape;
 use tassel_ffi::abi::{
-    tassel_character_free, tassel_character_load, tassel_frame, tassel_last_error,
-    tassel_set_shared_colliders, tassel_shared_colliders,
+    tassel_character_free, tassel_character_load, tassel_frame, tassel_set_shared_colliders,
+    tassel_shared_colliders,
 };
 use tassel_ffi::{FlatCharacter, FLOATS_PER_COLLIDER, FLOATS_PER_JOINT};
 
 const F: usize = FLOATS_PER_JOINT;
 const C: usize = FLOATS_PER_COLLIDER;
-
-fn last_error() -> String {
-    // SAFETY: NULL or this thread's NUL-terminated error.
-    let p = tassel_last_error();
-    assert!(!p.is_null());
-    unsafe { CStr::from_ptr(p) }.to_string_lossy().into_owned()
-}
 
 /// The built-in rig (chains only), its chains using shared collision (`shared`), with a
 /// `body` group of its torso and thighs.
@@ -74,7 +68,7 @@ fn shared_colliders_through_the_c_abi_act_as_rusts() {
     let mut rest = vec![0.0; n];
     source.rest_locals(&mut rest).unwrap();
     let src_ptr = {
-        let r = CString::new(source_rig_text()).unwrap();
+        let r = CString::new(rig(false)).unwrap();
         // SAFETY: as above.
         let p =
             unsafe { tassel_character_load(glb.as_ptr(), glb.len(), r.as_ptr(), std::ptr::null()) };
@@ -104,7 +98,7 @@ fn shared_colliders_through_the_c_abi_act_as_rusts() {
         assert_eq!(s, 0, "{}", last_error());
         // Rust: the source's colliders into the target.
         let world = source.sim().shared_colliders(Some("body")).unwrap();
-        rust.set_shared_colliders_rust(&world);
+        rust.set_shared_colliders(&encode(&world)).unwrap();
         // C: asked for the count, then written, then set.
         // SAFETY: NULL out with capacity 0 asks for the count.
         let count =
@@ -211,48 +205,26 @@ fn shared_colliders_through_the_c_abi_act_as_rusts() {
     }
 }
 
-fn source_rig_text() -> String {
-    rig(false)
-}
-
-trait SetRust {
-    fn set_shared_colliders_rust(&mut self, world: &[tassel::collide::PlacedCollider]);
-}
-
-impl SetRust for FlatCharacter {
-    /// Through Rust's API: the floats as the flat API encodes them.
-    fn set_shared_colliders_rust(&mut self, world: &[tassel::collide::PlacedCollider]) {
-        let mut floats = Vec::new();
-        for w in world {
-            let (k, p) = match w.shape {
-                Shape::Sphere { radius, inside } => {
-                    (0.0, [radius, f32::from(u8::from(inside)), 0.0, 0.0])
-                }
-                Shape::Capsule { radius, length } => (1.0, [radius, length, 0.0, 0.0]),
-                Shape::TaperedCapsule {
-                    radius0,
-                    radius1,
-                    length,
-                } => (2.0, [radius0, radius1, length, 0.0]),
-                Shape::Box { half_extents: h } => (3.0, [h.x, h.y, h.z, 0.0]),
-                Shape::Plane => (4.0, [0.0; 4]),
-            };
-            let t = w.transform;
-            floats.extend_from_slice(&[
-                k,
-                p[0],
-                p[1],
-                p[2],
-                p[3],
-                t.translation.x,
-                t.translation.y,
-                t.translation.z,
-                t.rotation.x,
-                t.rotation.y,
-                t.rotation.z,
-                t.rotation.w,
-            ]);
-        }
-        self.set_shared_colliders(&floats).unwrap();
+/// The colliders as 12 floats each, written here from the layout the C header documents
+/// (independently of the flat API's encoder).
+fn encode(world: &[tassel::collide::PlacedCollider]) -> Vec<f32> {
+    let mut floats = Vec::new();
+    for w in world {
+        let (k, p) = match w.shape {
+            Shape::Sphere { radius, inside } => {
+                (0.0, [radius, f32::from(u8::from(inside)), 0.0, 0.0])
+            }
+            Shape::Capsule { radius, length } => (1.0, [radius, length, 0.0, 0.0]),
+            Shape::TaperedCapsule {
+                radius0,
+                radius1,
+                length,
+            } => (2.0, [radius0, radius1, length, 0.0]),
+            Shape::Box { half_extents: h } => (3.0, [h.x, h.y, h.z, 0.0]),
+            Shape::Plane => (4.0, [0.0; 4]),
+        };
+        let (t, r) = (w.transform.translation, w.transform.rotation);
+        floats.extend_from_slice(&[k, p[0], p[1], p[2], p[3], t.x, t.y, t.z, r.x, r.y, r.z, r.w]);
     }
+    floats
 }

@@ -46,3 +46,13 @@ pub fn turn_about_x(locals: &mut [f32], j: usize, angle: f32) {
         * tassel::glam::Quat::from_xyzw(r[0], r[1], r[2], r[3]);
     r.copy_from_slice(&q.normalize().to_array());
 }
+
+/// `tassel_last_error()`'s message (this thread's last error).
+pub fn last_error() -> String {
+    let p = tassel_ffi::abi::tassel_last_error();
+    assert!(!p.is_null());
+    // SAFETY: this thread's NUL-terminated error, not NULL (checked).
+    unsafe { std::ffi::CStr::from_ptr(p) }
+        .to_string_lossy()
+        .into_owned()
+}

@@ -144,10 +144,15 @@ impl CompiledCollider {
     pub fn place(&self, models: &[Transform], frame: Option<&Transform>) -> PlacedCollider {
         let b = &models[self.bone];
         let bone = Transform::from_translation_rotation(b.translation, b.rotation);
-        let t = match frame {
-            Some(f) => *f * bone * self.offset,
-            None => bone * self.offset,
-        };
+        self.place_on(&match frame {
+            Some(f) => *f * bone,
+            None => bone,
+        })
+    }
+
+    /// Where it is when its bone is at `bone` (scale is ignored).
+    pub fn place_on(&self, bone: &Transform) -> PlacedCollider {
+        let t = *bone * self.offset;
         PlacedCollider {
             shape: self.shape,
             transform: Transform::from_translation_rotation(t.translation, t.rotation),

@@ -6,7 +6,7 @@
 
 use super::CharacterSim;
 use crate::collide::PlacedCollider;
-use crate::error::{Error, Result};
+use crate::error::Result;
 
 impl CharacterSim {
     /// This character's colliders in the world as its last frame's animated pose and
@@ -19,25 +19,25 @@ impl CharacterSim {
         group: Option<&str>,
         out: &mut Vec<PlacedCollider>,
     ) -> Result<()> {
-        let chains = &self.rig.chains;
-        let all;
-        let list: &[usize] = match group {
-            Some(name) => chains.collider_group(name).ok_or_else(|| {
-                Error::InvalidParameter(format!("the rig has no collider group named '{name}'"))
-            })?,
-            None => {
-                all = (0..chains.colliders.len()).collect::<Vec<_>>();
-                &all
-            }
-        };
         out.clear();
-        let models = self.animated_models();
-        let frame = self.component;
-        out.extend(
-            list.iter()
-                .map(|&c| chains.colliders[c].place(&models, Some(&frame))),
-        );
+        self.visit_shared_colliders(group, |c| out.push(c))?;
         Ok(())
+    }
+
+    /// Calls `f` with each collider [`shared_colliders_into`](Self::shared_colliders_into)
+    /// gives, in order, without collecting them; returns how many there were.
+    pub fn visit_shared_colliders(
+        &self,
+        group: Option<&str>,
+        mut f: impl FnMut(PlacedCollider),
+    ) -> Result<usize> {
+        let chains = &self.rig.chains;
+        let list = chains.shared_set(group)?;
+        let models = self.animated_models();
+        for &c in list {
+            f(chains.colliders[c].place(&models, Some(&self.component)));
+        }
+        Ok(list.len())
     }
 
     /// [`shared_colliders_into`](Self::shared_colliders_into) into a new vector.

@@ -546,6 +546,17 @@ impl ChainRig {
             .map(|g| g.1.as_slice())
     }
 
+    /// The colliders a character shares: those of the group `group`, or every collider
+    /// (`None`). An error names a group the rig does not define.
+    pub fn shared_set(&self, group: Option<&str>) -> Result<&[usize]> {
+        match group {
+            None => Ok(&self.constraints.all_colliders),
+            Some(name) => self.collider_group(name).ok_or_else(|| {
+                Error::InvalidParameter(format!("the rig has no collider group named '{name}'"))
+            }),
+        }
+    }
+
     /// Whether any bone constraint joins this rig's chains (then its chains with
     /// constraints step per character, not in a [`crate::crowd::ChainCrowd`]'s lanes).
     pub fn has_bone_constraints(&self) -> bool {
@@ -672,17 +683,10 @@ impl ChainRig {
     /// it is in the world, as other characters' chains see it
     /// ([`crate::CharacterSim::set_shared_colliders`]).
     pub fn collider_at(&self, c: usize, bone: &crate::Transform) -> crate::collide::PlacedCollider {
-        let models = [crate::Transform::from_translation_rotation(
+        self.colliders[c].place_on(&crate::Transform::from_translation_rotation(
             bone.translation,
             bone.rotation,
-        )];
-        let col = &self.colliders[c];
-        let one = CompiledCollider {
-            bone: 0,
-            offset: col.offset,
-            shape: col.shape,
-        };
-        one.place(&models, None)
+        ))
     }
 
     /// How many lane groups of twin chains (the same points, parameters, settings and

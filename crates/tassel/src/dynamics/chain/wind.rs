@@ -349,7 +349,8 @@ pub fn smooth_noise(u: f32, seed: i32, channel: i32) -> f32 {
     v0 + s * (v1 - v0)
 }
 
-/// A gust: a strength that rises, holds and decays on the wind's clock.
+/// A gust: a strength that rises, holds and decays on the wind's clock (gone once it
+/// has decayed or is stopped at once).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub(crate) struct Gust {
     pub start: f32,
@@ -357,15 +358,11 @@ pub(crate) struct Gust {
     pub rise: f32,
     pub hold: f32,
     pub decay: f32,
-    pub active: bool,
 }
 
 impl Gust {
     /// Its strength at wind time `t` (KawaiiPhysics' `EvaluateActiveGust`).
     pub(crate) fn at(&self, t: f32) -> f32 {
-        if !self.active {
-            return 0.0;
-        }
         self.strength
             * super::overrides::envelope_alpha(self.rise, self.hold, self.decay, t - self.start)
     }
@@ -439,7 +436,6 @@ impl WindClock {
                 rise: r.rise,
                 hold: r.hold,
                 decay: r.decay,
-                active: true,
             });
         }
         if let Some(blend_out) = self.stop.take() {
@@ -454,7 +450,6 @@ impl WindClock {
                     rise: 0.0,
                     hold: 0.0,
                     decay: blend_out,
-                    active: true,
                 };
             }
         }
