@@ -42,7 +42,8 @@ impl<T: Lane> Placed<T> {
 
 /// The specification's signed distance per lane
 /// ([`crate::dynamics::vrm::PlacedVrmCollider::collision`]) with the vector it is measured
-/// along, or `None` when no lane can be in contact.
+/// along, or `None` when no lane of `lanes` (the lanes whose result the caller uses) can
+/// be in contact.
 ///
 /// The early `None` compares against a bounding sphere rounded outward, so it only ever
 /// skips what the exact test would find out of contact: the results keep the scalar bits.
@@ -52,6 +53,7 @@ pub(crate) fn distance<T: Lane>(
     placed: &Placed<T>,
     p: V3<T>,
     r: T,
+    lanes: T::M,
 ) -> Option<(T, V3<T>)> {
     let zero = T::splat(0.0);
     let (radius, inside) = match *shape {
@@ -68,7 +70,7 @@ pub(crate) fn distance<T: Lane>(
         // few operations (so that no lane the exact test would push is skipped).
         let reach = (placed.half + (T::splat(radius) + r)) * T::splat(1.0001) + T::splat(1e-6);
         let far = (p - placed.mid).dot(p - placed.mid).gt(reach * reach);
-        if far == <T::M as Mask>::ALL {
+        if far.or(lanes.not()) == <T::M as Mask>::ALL {
             return None;
         }
     }
@@ -93,17 +95,19 @@ pub(crate) fn distance<T: Lane>(
     })
 }
 
-/// The push of the specification's collision: `None` when no lane is in contact, else the
-/// direction, the signed distance and the lanes in contact. The direction (three
-/// divisions and a square root) is computed only when a lane is in contact.
+/// The push of the specification's collision: `None` when no lane of `lanes` is in contact,
+/// else the direction, the signed distance and the lanes in contact (of `lanes` and maybe
+/// others). The direction (three divisions and a square root) is computed only when a lane
+/// is in contact.
 #[inline(always)]
 pub(crate) fn contact<T: Lane>(
     shape: &VrmShape,
     placed: &Placed<T>,
     p: V3<T>,
     r: T,
+    lanes: T::M,
 ) -> Option<(V3<T>, T, T::M)> {
-    let (dist, delta) = distance(shape, placed, p, r)?;
+    let (dist, delta) = distance(shape, placed, p, r, lanes)?;
     let hit = dist.lt(T::splat(0.0));
     if !hit.any() {
         return None;
@@ -123,15 +127,16 @@ pub(crate) fn contact<T: Lane>(
 }
 
 /// How far a tail at `p` violates the collider, per lane (≤ 0: not at all), or `None` when
-/// no lane can.
+/// no lane of `lanes` can.
 #[inline(always)]
 pub(crate) fn penetration<T: Lane>(
     shape: &VrmShape,
     placed: &Placed<T>,
     p: V3<T>,
     r: T,
+    lanes: T::M,
 ) -> Option<T> {
-    distance(shape, placed, p, r).map(|(d, _)| -d)
+    distance(shape, placed, p, r, lanes).map(|(d, _)| -d)
 }
 
 /// [`crate::dynamics::vrm::PlacedVrmCollider::settle`] per lane.
@@ -208,10 +213,11 @@ pub(crate) fn collide_tail<T: Lane>(
 ) -> (V3<T>, T::M) {
     let mut acted = <T::M as Mask>::NONE;
     let only = |k: usize| masks.map(|m| <T::M as Mask>::of(m[k]));
+    let every = <T::M as Mask>::ALL;
     for (k, &c) in colliders.iter().enumerate() {
         let shape = &shapes[c].1;
         let pl = Placed::<T>::of(&placed[c]);
-        if let Some((dir, dist, hit)) = contact(shape, &pl, tail, r) {
+        if let Some((dir, dist, hit)) = contact(shape, &pl, tail, r, only(k).unwrap_or(every)) {
             let hit = match only(k) {
                 Some(m) => hit.and(m),
                 None => hit,
@@ -227,15 +233,22 @@ pub(crate) fn collide_tail<T: Lane>(
     let before_settling = tail;
     // A lane where no collider acted kept its tail, at which every collider's distance
     // was found not negative: no penetration to settle (the scalar settling's first pass
-    // changes nothing and stops). So with no lane acted, the settling is skipped.
+    // changes nothing and stops). So with no lane acted, the settling is skipped, and it
+    // only asks about the lanes that were pushed (the others are not inside: a collider
+    // whose bounding sphere is out of the pushed lanes' reach is not tested at all).
     if exact && acted.any() {
         let zero = T::splat(0.0);
+        let pushed = acted;
         for _ in 0..2 {
             let mut changed = <T::M as Mask>::NONE;
             for (k, &c) in colliders.iter().enumerate() {
                 let shape = &shapes[c].1;
                 let pl = Placed::<T>::of(&placed[c]);
-                let Some(before) = penetration(shape, &pl, tail, r) else {
+                let lanes = match only(k) {
+                    Some(m) => pushed.and(m),
+                    None => pushed,
+                };
+                let Some(before) = penetration(shape, &pl, tail, r, lanes) else {
                     continue;
                 };
                 let inside = match only(k) {
@@ -246,7 +259,8 @@ pub(crate) fn collide_tail<T: Lane>(
                     continue;
                 }
                 let t = settle_one(shape, &pl, position, length, tail, r);
-                let after = match penetration(shape, &pl, t, r) {
+                // (`None`: every lane inside is now out of reach, so less deep.)
+                let after = match penetration(shape, &pl, t, r, inside) {
                     Some(p) => p,
                     None => T::splat(f32::NEG_INFINITY),
                 };
