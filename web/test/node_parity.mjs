@@ -2,11 +2,12 @@
 // its crowd against its manager (crowd.mjs), on every VRM file of ../shared/testdata/vrm.
 import fs from 'node:fs';
 import path from 'node:path';
-import { TasselSpringBoneManager, TasselCrowd, TasselCharacter } from '../dist/index.js';
+import { TasselSpringBoneManager, TasselCrowd, TasselCharacter, loadTassel, builtinAvatar } from '../dist/index.js';
 import { loadGltfBytes } from './gltf.mjs';
 import { vrmFiles, testdata, THREE } from './load.mjs';
 import { runParity } from './parity.mjs';
 import { runCrowdParity } from './crowd.mjs';
+import { runShareRig } from './share.mjs';
 
 const files = vrmFiles().map((f) => ({ name: path.basename(f), bytes: fs.readFileSync(f) }));
 const hook = files.length
@@ -82,5 +83,6 @@ async function runEvents() {
   return bad;
 }
 failures += await runEvents();
+failures += await runShareRig({ loadGltfBytes, TasselSpringBoneManager, loadTassel, builtinAvatar, log: console.log });
 console.log(failures ? `node parity: ${failures} FAILED` : `node parity: all passed (${files.length} files)`);
 process.exit(failures ? 1 : 0);

@@ -81,6 +81,17 @@ TasselCharacter *tassel_character_load_file(const char *path,
                                             const char *rig_toml,
                                             const char *mode);
 
+// A new character of the same kind as `c`, as a load of the same file, rig and mode
+// would make it (fresh state, the rest pose), sharing `c`'s compiled rig: nothing is
+// parsed or compiled again, and copies of one avatar keep one rig in memory (see
+// `FlatCharacter::fresh_copy`). `c`'s own state is not copied, and `c` may be freed
+// before its copies. NULL on error (`tassel_last_error` says why). Free it with
+// `tassel_character_free`.
+//
+// # Safety
+// `c` is NULL or a live character.
+TasselCharacter *tassel_character_copy(const TasselCharacter *c);
+
 // Frees a character (NULL: nothing happens).
 //
 // # Safety

@@ -279,6 +279,24 @@ pub unsafe extern "C" fn tassel_character_load_file(
     })
 }
 
+/// A new character of the same kind as `c`, as a load of the same file, rig and mode
+/// would make it (fresh state, the rest pose), sharing `c`'s compiled rig: nothing is
+/// parsed or compiled again, and copies of one avatar keep one rig in memory (see
+/// `FlatCharacter::fresh_copy`). `c`'s own state is not copied, and `c` may be freed
+/// before its copies. NULL on error (`tassel_last_error` says why). Free it with
+/// `tassel_character_free`.
+///
+/// # Safety
+/// `c` is NULL or a live character.
+#[no_mangle]
+pub unsafe extern "C" fn tassel_character_copy(c: *const TasselCharacter) -> *mut TasselCharacter {
+    guard("tassel_character_copy", std::ptr::null_mut(), || {
+        // SAFETY: the caller's promise.
+        let flat = unsafe { character(c) }?.flat.fresh_copy()?;
+        Ok(new_character(flat))
+    })
+}
+
 /// Frees a character (NULL: nothing happens).
 ///
 /// # Safety

@@ -347,6 +347,28 @@ impl FlatCharacter {
         })
     }
 
+    /// A new character of the same kind, as [`load`](Self::load) would make it from the
+    /// same file, rig and mode (fresh state, the rest pose, no shared colliders, the
+    /// default SIMD use), sharing this one's compiled rig: no file is parsed and nothing
+    /// is compiled again, and many copies of one avatar keep one rig in memory. This
+    /// character's own state (stepped or not) is not copied.
+    pub fn fresh_copy(&self) -> Result<Self, String> {
+        let mut sim = CharacterSim::from_rig(self.sim.rig().clone());
+        let rest = sim.skeleton().rest().to_vec();
+        // The state before `tassel simulate`'s frame 1, as a load leaves it.
+        sim.frame(&rest, Transform::IDENTITY, 0.0)
+            .map_err(|e| e.to_string())?;
+        Ok(Self {
+            sim,
+            mode: self.mode,
+            node_to_joint: self.node_to_joint.clone(),
+            joint_to_node: self.joint_to_node.clone(),
+            written: self.written.clone(),
+            read: self.read.clone(),
+            animated: rest,
+        })
+    }
+
     /// How many joints (the file's nodes).
     pub fn joint_count(&self) -> usize {
         self.node_to_joint.len()
