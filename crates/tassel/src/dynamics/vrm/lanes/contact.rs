@@ -212,6 +212,8 @@ pub(crate) fn collide_tail<T: Lane>(
     limit: Option<(&LinkLimit, Q<T>)>,
 ) -> (V3<T>, T::M) {
     let mut acted = <T::M as Mask>::NONE;
+    // Per lane, the entry of the last collider that pushed it (-1: none).
+    let mut last = T::splat(-1.0);
     let only = |k: usize| masks.map(|m| <T::M as Mask>::of(m[k]));
     let every = <T::M as Mask>::ALL;
     for (k, &c) in colliders.iter().enumerate() {
@@ -225,6 +227,7 @@ pub(crate) fn collide_tail<T: Lane>(
             let pushed = position + (tail - dir * dist - position).normalize_or(rest_dir) * length;
             tail = V3::select(hit, pushed, tail);
             acted = acted.or(hit);
+            last = T::select(hit, T::splat(k as f32), last);
             if let Some((lim, parent_r)) = limit {
                 tail = limit_lanes(lim, parent_r, position, tail, length, hit);
             }
@@ -233,28 +236,34 @@ pub(crate) fn collide_tail<T: Lane>(
     let before_settling = tail;
     // A lane where no collider acted kept its tail, at which every collider's distance
     // was found not negative: no penetration to settle (the scalar settling's first pass
-    // changes nothing and stops). So with no lane acted, the settling is skipped, and it
-    // only asks about the lanes that were pushed (the others are not inside: a collider
-    // whose bounding sphere is out of the pushed lanes' reach is not tested at all).
+    // changes nothing and stops). So with no lane acted, the settling is skipped. Its first
+    // pass asks about a collider only for the lanes that can be inside it: those pushed by
+    // it or a later entry (a lane's tail has not moved since the entries after its last
+    // push found it outside them), and those this pass moved already; a collider whose
+    // bounding sphere is out of their reach is not tested at all. Its second pass asks
+    // only about the lanes the first changed: a lane the first left as it was meets every
+    // collider at the same tail again, so the same decisions.
     if exact && acted.any() {
         let zero = T::splat(0.0);
-        let pushed = acted;
+        let mut second = None;
         for _ in 0..2 {
             let mut changed = <T::M as Mask>::NONE;
             for (k, &c) in colliders.iter().enumerate() {
                 let shape = &shapes[c].1;
                 let pl = Placed::<T>::of(&placed[c]);
+                let asked = match second {
+                    Some(m) => m,
+                    None => T::splat(k as f32).le(last).or(changed),
+                };
                 let lanes = match only(k) {
-                    Some(m) => pushed.and(m),
-                    None => pushed,
+                    Some(m) => asked.and(m),
+                    None => asked,
                 };
                 let Some(before) = penetration(shape, &pl, tail, r, lanes) else {
                     continue;
                 };
-                let inside = match only(k) {
-                    Some(m) => zero.lt(before).and(m),
-                    None => zero.lt(before),
-                };
+                // (Only the lanes asked about: the others would change nothing here.)
+                let inside = zero.lt(before).and(lanes);
                 if !inside.any() {
                     continue;
                 }
@@ -272,6 +281,7 @@ pub(crate) fn collide_tail<T: Lane>(
             if !changed.any() {
                 break;
             }
+            second = Some(changed);
         }
         if let Some((lim, parent_r)) = limit {
             let moved = differs(tail, before_settling);
