@@ -16,19 +16,7 @@ const F: usize = FLOATS_PER_JOINT;
 /// rest pose with the first two read joints turned about x.
 fn input(c: &FlatCharacter, f: usize) -> ([f32; F], Vec<f32>) {
     let t = f as f32 / 60.0;
-    let (s, co) = ((0.4 * (3.0 * t).sin()) / 2.0).sin_cos();
-    let root = [
-        0.3 * (2.0 * t).sin(),
-        0.1 * (5.0 * t).cos(),
-        0.0,
-        0.0,
-        s,
-        0.0,
-        co,
-        1.0,
-        1.0,
-        1.0,
-    ];
+    let root = common::swaying_root(f);
     let mut locals = vec![0.0; c.joint_count() * F];
     c.rest_locals(&mut locals).unwrap();
     for (k, &j) in c.read_joints().iter().take(2).enumerate() {

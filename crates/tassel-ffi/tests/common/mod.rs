@@ -56,3 +56,22 @@ pub fn last_error() -> String {
         .to_string_lossy()
         .into_owned()
 }
+
+/// A character's root (10 floats) at frame `f` of 60 Hz: swaying along x and y and turning
+/// about y.
+pub fn swaying_root(f: usize) -> [f32; tassel_ffi::FLOATS_PER_JOINT] {
+    let t = f as f32 / 60.0;
+    let (s, co) = ((0.4 * (3.0 * t).sin()) / 2.0).sin_cos();
+    [
+        0.3 * (2.0 * t).sin(),
+        0.1 * (5.0 * t).cos(),
+        0.0,
+        0.0,
+        s,
+        0.0,
+        co,
+        1.0,
+        1.0,
+        1.0,
+    ]
+}
