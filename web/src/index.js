@@ -120,11 +120,12 @@ class Tassel {
   character(bytes, rigToml, mode) {
     const data = bytes instanceof Uint8Array ? bytes : new Uint8Array(bytes);
     const key = `${sampleHash(data)}:${mode ?? ''}`;
-    let list = this.kinds.get(key);
-    if (!list) this.kinds.set(key, (list = []));
-    let kind = list.find((k) => k.rig === (rigToml ?? null) && sameBytes(k.data, data));
+    let kind = this.kinds.get(key)?.find((k) => k.rig === (rigToml ?? null) && sameBytes(k.data, data));
     if (!kind) {
+      // Loaded first: a file that does not load leaves no entry behind.
       kind = { data: data.slice(), rig: rigToml ?? null, mode: mode ?? null, template: this.load(data, rigToml, mode), users: 0 };
+      let list = this.kinds.get(key);
+      if (!list) this.kinds.set(key, (list = []));
       list.push(kind);
     }
     const ptr = this.x.tassel_character_copy(kind.template);

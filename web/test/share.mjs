@@ -58,6 +58,7 @@ export async function runShareRig({ loadGltfBytes, TasselSpringBoneManager, load
   const spec = await make(bytes, { mode: 'spec' });
   ok(kinds().length === 3, `three kinds: ${kinds().length}`);
   for (const x of [b, rig, spec, own, fresh]) x.m.dispose();
+  // A second dispose releases nothing more (the kind's count stays right).
   b.m.dispose();
   ok(kinds().length === 0, `every template freed with its last user: ${kinds().length} left`);
   log(bad ? `share: ${bad} failures` : 'share: managers of one file share its rig, bit for bit as their own');
