@@ -139,7 +139,8 @@ pub(crate) fn penetration<T: Lane>(
     distance(shape, placed, p, r, lanes).map(|(d, _)| -d)
 }
 
-/// [`crate::dynamics::vrm::PlacedVrmCollider::settle`] per lane.
+/// [`crate::dynamics::vrm::PlacedVrmCollider::settle`] per lane, or `None` where it
+/// keeps the tail of every lane of `lanes` (the lanes whose result is used).
 #[inline(always)]
 pub(crate) fn settle_one<T: Lane>(
     shape: &VrmShape,
@@ -148,7 +149,8 @@ pub(crate) fn settle_one<T: Lane>(
     length: T,
     tail: V3<T>,
     r: T,
-) -> V3<T> {
+    lanes: T::M,
+) -> Option<V3<T>> {
     let zero = T::splat(0.0);
     let one = T::splat(1.0);
     let (a, c, valid) = match *shape {
@@ -181,12 +183,15 @@ pub(crate) fn settle_one<T: Lane>(
     let u = (tail - pos).normalize_or(a);
     let ua = u.dot(a);
     let keep = (c - T::splat(1e-6)).le(ua).or(c.lt(T::splat(-1.0)));
+    let unchanged = length.le(zero).or(valid.not()).or(keep);
+    if !lanes.and(unchanged.not()).any() {
+        return None;
+    }
     let straight = pos + a * length;
     let side = (u - a * ua).normalize_or(a.any_orthonormal());
     let turned = pos + (a * c + side * (one - c * c).sqrt()) * length;
     let moved = V3::select(T::splat(1.0).le(c), straight, turned);
-    let unchanged = length.le(zero).or(valid.not()).or(keep);
-    V3::select(unchanged, tail, moved)
+    Some(V3::select(unchanged, tail, moved))
 }
 
 /// The specification's collision (one push per collider and the projection back to
@@ -236,52 +241,85 @@ pub(crate) fn collide_tail<T: Lane>(
     let before_settling = tail;
     // A lane where no collider acted kept its tail, at which every collider's distance
     // was found not negative: no penetration to settle (the scalar settling's first pass
-    // changes nothing and stops). So with no lane acted, the settling is skipped. Its first
-    // pass asks about a collider only for the lanes that can be inside it: those pushed by
-    // it or a later entry (a lane's tail has not moved since the entries after its last
-    // push found it outside them), and those this pass moved already; a collider whose
-    // bounding sphere is out of their reach is not tested at all. Its second pass asks
-    // only about the lanes the first changed: a lane the first left as it was meets every
-    // collider at the same tail again, so the same decisions.
+    // changes nothing and stops). So with no lane acted, the settling is skipped.
+    //
+    // The first pass asks about a collider only for the lanes that can be inside it:
+    // those pushed by it or a later entry (a lane's tail has not moved since the entries
+    // after its last push found it outside them), and those this pass moved already; a
+    // collider whose bounding sphere is out of their reach is not tested at all.
+    //
+    // The second pass runs for the lanes the first changed (a lane the first left as it
+    // was meets every collider at the same tail again, so the same decisions), and of
+    // those it asks an entry only about the lanes that can decide otherwise than in the
+    // first pass: the entries before the one that moved a lane last (they saw another
+    // tail), that entry itself only where its tail was still inside it (its depth there
+    // is known: the first pass measured it at this very tail), and every entry for the
+    // lanes this pass moved. The entries after it saw this tail in the first pass and
+    // left it.
     if exact && acted.any() {
         let zero = T::splat(0.0);
-        let mut second = None;
-        for _ in 0..2 {
-            let mut changed = <T::M as Mask>::NONE;
+        let out_of_reach = T::splat(f32::NEG_INFINITY);
+        let mut first = <T::M as Mask>::NONE;
+        // Per lane, the entry that moved it last in the first pass and its depth there.
+        let mut moved_at = T::splat(-1.0);
+        let mut depth = zero;
+        for (k, &c) in colliders.iter().enumerate() {
+            let shape = &shapes[c].1;
+            let pl = Placed::<T>::of(&placed[c]);
+            let kk = T::splat(k as f32);
+            let asked = kk.le(last).or(first);
+            let lanes = match only(k) {
+                Some(m) => asked.and(m),
+                None => asked,
+            };
+            let Some(before) = penetration(shape, &pl, tail, r, lanes) else {
+                continue;
+            };
+            // (Only the lanes asked about: the others would change nothing here.)
+            let inside = zero.lt(before).and(lanes);
+            if !inside.any() {
+                continue;
+            }
+            let (t, moved, after) =
+                settle_lanes(shape, &pl, position, length, tail, r, before, inside);
+            tail = t;
+            first = first.or(moved);
+            moved_at = T::select(moved, kk, moved_at);
+            depth = T::select(moved, after, depth);
+        }
+        acted = acted.or(first);
+        if first.any() {
+            let mut second = <T::M as Mask>::NONE;
             for (k, &c) in colliders.iter().enumerate() {
                 let shape = &shapes[c].1;
                 let pl = Placed::<T>::of(&placed[c]);
-                let asked = match second {
-                    Some(m) => m,
-                    None => T::splat(k as f32).le(last).or(changed),
-                };
-                let lanes = match only(k) {
-                    Some(m) => asked.and(m),
-                    None => asked,
-                };
-                let Some(before) = penetration(shape, &pl, tail, r, lanes) else {
+                let kk = T::splat(k as f32);
+                let mut asked = first.and(kk.lt(moved_at)).or(second);
+                let same = first.and(second.not()).and(kk.ne(moved_at).not());
+                let mut known = same.and(zero.lt(depth));
+                if let Some(m) = only(k) {
+                    asked = asked.and(m);
+                    known = known.and(m);
+                }
+                if !asked.or(known).any() {
                     continue;
+                }
+                let measured = if asked.any() {
+                    penetration(shape, &pl, tail, r, asked).unwrap_or(out_of_reach)
+                } else {
+                    out_of_reach
                 };
-                // (Only the lanes asked about: the others would change nothing here.)
-                let inside = zero.lt(before).and(lanes);
+                let before = T::select(known, depth, measured);
+                let inside = zero.lt(before).and(asked.or(known));
                 if !inside.any() {
                     continue;
                 }
-                let t = settle_one(shape, &pl, position, length, tail, r);
-                // (`None`: every lane inside is now out of reach, so less deep.)
-                let after = match penetration(shape, &pl, t, r, inside) {
-                    Some(p) => p,
-                    None => T::splat(f32::NEG_INFINITY),
-                };
-                let better = inside.and(after.lt(before));
-                changed = changed.or(better.and(differs(t, tail)));
-                tail = V3::select(better, t, tail);
+                let (t, moved, _) =
+                    settle_lanes(shape, &pl, position, length, tail, r, before, inside);
+                tail = t;
+                second = second.or(moved);
             }
-            acted = acted.or(changed);
-            if !changed.any() {
-                break;
-            }
-            second = Some(changed);
+            acted = acted.or(second);
         }
         if let Some((lim, parent_r)) = limit {
             let moved = differs(tail, before_settling);
@@ -289,6 +327,36 @@ pub(crate) fn collide_tail<T: Lane>(
         }
     }
     (tail, acted)
+}
+
+/// One settling of the lanes `inside` (whose depth is `before`) on a collider: the tail,
+/// new where it is less deep; the lanes it moved; the depth of the new tail (minus
+/// infinity where out of reach). A function, not a closure: a closure would not be
+/// compiled with the target features of the update that inlines it.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn settle_lanes<T: Lane>(
+    shape: &VrmShape,
+    pl: &Placed<T>,
+    position: V3<T>,
+    length: T,
+    tail: V3<T>,
+    r: T,
+    before: T,
+    inside: T::M,
+) -> (V3<T>, T::M, T) {
+    let Some(t) = settle_one(shape, pl, position, length, tail, r, inside) else {
+        // Every lane inside keeps its tail: its depth is `before` again, no better.
+        return (tail, <T::M as Mask>::NONE, before);
+    };
+    // (`None`: every lane inside is now out of reach, so less deep.)
+    let after = penetration(shape, pl, t, r, inside).unwrap_or(T::splat(f32::NEG_INFINITY));
+    let better = inside.and(after.lt(before));
+    (
+        V3::select(better, t, tail),
+        better.and(differs(t, tail)),
+        after,
+    )
 }
 
 /// [`LinkLimit::apply`] on the lanes in `lanes`, lane by lane with the scalar code (the
