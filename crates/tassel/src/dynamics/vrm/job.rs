@@ -469,62 +469,73 @@ fn update(
         lanes.update(rig, &mut io, isa);
         return true;
     }
-    let exact = mode == VrmMode::Fixed;
     // Model transforms at or above this index are stale (a rotation above them changed).
     let mut stale_from = sk.len();
+    let mut io = state.lane_io(component, dt, mode, locals, models);
     for (i, l) in rig.links.iter().enumerate() {
         if stale_from <= l.joint {
-            refresh(sk, locals, models, stale_from, l.joint);
+            refresh(sk, io.locals, io.models, stale_from, l.joint);
         }
-        let parent_world = parent_world(l, component, models);
-        let position = (*component * models[l.joint]).translation;
-        let center = l.center.map(|c| *component * models[c]);
-        let to_world = |t: Vec3| center.map_or(t, |c| c.transform_point(t));
-        let current = to_world(state.current_tail[i]);
-        let prev = to_world(state.prev_tail[i]);
-
-        // Verlet: inertia, stiffness toward the rest direction under the current parent,
-        // gravity; then back to the bone length.
-        let rest_dir = rest_dir(l, &parent_world);
-        let (carry_motion, carry_force) = state.carry;
-        let inertia = (current - prev) * (1.0 - l.drag_force) * carry_motion;
-        let stiffness = rest_dir * (l.stiffness * dt) * carry_force;
-        let external = l.gravity * dt * carry_force;
-        let length = match (mode, l.tail_joint) {
-            // three-vrm re-measures the bone against the tail node's world matrix, which
-            // still holds the end of the last frame.
-            (VrmMode::ThreeVrm, Some(_)) => (state.stale_tail[i] - position).length(),
-            _ => state.length[i],
-        };
-        let next = position
-            + normalize_or(
-                current + inertia + stiffness + external - position,
-                rest_dir,
-            ) * length;
-        // The draft limit (`VRMC_springBone_limit`): after inertia, and after each push.
-        let next = limited(l, parent_world.rotation, position, next, length);
-        let (next, _) = collide_tail(
-            rig,
-            state,
-            l,
-            parent_world.rotation,
-            position,
-            length,
-            rest_dir,
-            next,
-            exact,
-        );
-
-        let to_stored = |t: Vec3| center.map_or(t, |c| c.inverse_transform_point(t));
-        state.prev_tail[i] = state.current_tail[i];
-        state.current_tail[i] = to_stored(next);
-        state.rotation[i] = turn_toward(l, &parent_world, next, locals, models);
+        update_link(rig, &mut io, i);
         stale_from = l.joint + 1;
     }
     if stale_from < sk.len() {
-        refresh(sk, locals, models, stale_from, sk.len() - 1);
+        refresh(sk, io.locals, io.models, stale_from, sk.len() - 1);
     }
     false
+}
+
+/// The update of link `i` (the specification's procedure, as [`update`] describes it):
+/// its model in `io.models` must be fresh, and its parent's. Writes its tails, its
+/// rotation, its local rotation and its model. The scalar update runs every link through
+/// it; the lane update the links of the rows where lanes lose.
+pub(crate) fn update_link(rig: &VrmRig, io: &mut SpringIo<'_>, i: usize) {
+    let l = &rig.links[i];
+    let component = io.component;
+    let parent_world = parent_world(l, &component, io.models);
+    let position = (component * io.models[l.joint]).translation;
+    let center = l.center.map(|c| component * io.models[c]);
+    let to_world = |t: Vec3| center.map_or(t, |c| c.transform_point(t));
+    let current = to_world(io.current_tail[i]);
+    let prev = to_world(io.prev_tail[i]);
+
+    // Verlet: inertia, stiffness toward the rest direction under the current parent,
+    // gravity; then back to the bone length.
+    let rest_dir = rest_dir(l, &parent_world);
+    let (carry_motion, carry_force) = io.carry;
+    let dt = io.dt;
+    let inertia = (current - prev) * (1.0 - l.drag_force) * carry_motion;
+    let stiffness = rest_dir * (l.stiffness * dt) * carry_force;
+    let external = l.gravity * dt * carry_force;
+    let length = match (io.mode, l.tail_joint) {
+        // three-vrm re-measures the bone against the tail node's world matrix, which
+        // still holds the end of the last frame.
+        (VrmMode::ThreeVrm, Some(_)) => (io.stale_tail[i] - position).length(),
+        _ => io.length[i],
+    };
+    let next = position
+        + normalize_or(
+            current + inertia + stiffness + external - position,
+            rest_dir,
+        ) * length;
+    // The draft limit (`VRMC_springBone_limit`): after inertia, and after each push.
+    let next = limited(l, parent_world.rotation, position, next, length);
+    let (next, _) = collide_tail(
+        rig,
+        io.placed,
+        l,
+        parent_world.rotation,
+        position,
+        length,
+        rest_dir,
+        next,
+        io.mode == VrmMode::Fixed,
+    );
+
+    let to_stored = |t: Vec3| center.map_or(t, |c| c.inverse_transform_point(t));
+    io.prev_tail[i] = io.current_tail[i];
+    io.current_tail[i] = to_stored(next);
+    io.rotation[i] = turn_toward(l, &parent_world, next, io.locals, io.models);
 }
 
 /// The world transform of the link's parent (the character's at a skeleton root).
@@ -546,7 +557,7 @@ fn rest_dir(l: &VrmLink, parent_world: &Transform) -> Vec3 {
 #[allow(clippy::too_many_arguments)]
 fn collide_tail(
     rig: &VrmRig,
-    state: &VrmState,
+    placed: &[PlacedVrmCollider],
     l: &VrmLink,
     parent_rotation: Quat,
     position: Vec3,
@@ -557,7 +568,7 @@ fn collide_tail(
 ) -> (Vec3, bool) {
     let mut acted = false;
     for &c in &rig.link_colliders[l.colliders.clone()] {
-        let (dir, dist) = state.placed[c].collision(tail, l.hit_radius);
+        let (dir, dist) = placed[c].collision(tail, l.hit_radius);
         if dist < 0.0 {
             tail = position + normalize_or(tail - dir * dist - position, rest_dir) * length;
             tail = limited(l, parent_rotation, position, tail, length);
@@ -565,7 +576,7 @@ fn collide_tail(
         }
     }
     if exact {
-        let mut settled = settle(rig, state, l, position, length, tail);
+        let mut settled = settle(rig, placed, l, position, length, tail);
         if settled != tail {
             settled = limited(l, parent_rotation, position, settled, length);
             acted = true;
@@ -610,7 +621,7 @@ fn turn_toward(
 /// link's colliders.
 fn settle(
     rig: &VrmRig,
-    state: &VrmState,
+    placed: &[PlacedVrmCollider],
     l: &VrmLink,
     position: Vec3,
     length: f32,
@@ -619,13 +630,13 @@ fn settle(
     for _ in 0..2 {
         let mut changed = false;
         for &c in &rig.link_colliders[l.colliders.clone()] {
-            let placed = &state.placed[c];
-            let before = placed.penetration(tail, l.hit_radius);
+            let collider = &placed[c];
+            let before = collider.penetration(tail, l.hit_radius);
             if before > 0.0 {
-                let t = placed.settle(position, length, tail, l.hit_radius);
+                let t = collider.settle(position, length, tail, l.hit_radius);
                 // Only ever an improvement (a capsule's cone is taken about the axis point
                 // nearest the tail, which can mislead when the joint sits on the axis).
-                if placed.penetration(t, l.hit_radius) < before {
+                if collider.penetration(t, l.hit_radius) < before {
                     changed |= t != tail;
                     tail = t;
                 }

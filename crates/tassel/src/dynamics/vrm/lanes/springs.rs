@@ -23,6 +23,7 @@
 //! model there, the pose jobs compose it under the identity).
 
 use super::contact::{collide_tail, Placed};
+use crate::dynamics::vrm::job::update_link;
 use crate::dynamics::vrm::{PlacedVrmCollider, VrmMode, VrmRig};
 #[cfg(target_arch = "x86_64")]
 use crate::lanes::avx::Fa;
@@ -380,7 +381,7 @@ impl SpringLanes {
 
     #[inline(never)]
     fn update_baseline(&self, rig: &VrmRig, io: &mut SpringIo<'_>) {
-        self.update_lanes::<F>(rig, io)
+        self.update_lanes::<F>(rig, io, LANES / 4)
     }
 
     #[cfg(target_arch = "x86_64")]
@@ -389,7 +390,7 @@ impl SpringLanes {
     fn update_avx2(&self, rig: &VrmRig, io: &mut SpringIo<'_>) {
         // The explicit AVX2 lane type only inside this function, after the CPU was found
         // to have AVX2 (the condition of its soundness, `lanes/avx.rs`).
-        self.update_lanes::<Fa>(rig, io)
+        self.update_lanes::<Fa>(rig, io, 3)
     }
 
     #[cfg(target_arch = "x86_64")]
@@ -398,11 +399,14 @@ impl SpringLanes {
     fn update_avx512(&self, rig: &VrmRig, io: &mut SpringIo<'_>) {
         // The explicit AVX-512 lane type only inside this function, after the CPU was
         // found to have it (the condition of its soundness, `lanes/avx512.rs`).
-        self.update_lanes::<Fz>(rig, io)
+        self.update_lanes::<Fz>(rig, io, 1)
     }
 
+    /// The update in lanes of type `T`; the rows with at most `scalar_rows` lanes in use
+    /// run link by link with the scalar update instead (the same bits: each link's update
+    /// reads only its own state, its parent's model and the colliders).
     #[inline(always)]
-    fn update_lanes<T: Lane>(&self, rig: &VrmRig, io: &mut SpringIo<'_>) {
+    fn update_lanes<T: Lane>(&self, rig: &VrmRig, io: &mut SpringIo<'_>, scalar_rows: usize) {
         let comp = Trs::<T>::of(&Trs::splat(&io.component));
         let dt = T::splat(io.dt);
         let (carry_motion, carry_force) = (T::splat(io.carry.0), T::splat(io.carry.1));
@@ -417,6 +421,19 @@ impl SpringLanes {
             };
             let mut above = Trs::<T>::of(&Trs::splat(&Transform::IDENTITY));
             for (d, row) in g.rows.iter().enumerate() {
+                if row.n <= scalar_rows {
+                    // This row and the rest of the group (no wider: columns are sorted
+                    // longest first) link by link with the scalar update, each link's
+                    // model first made fresh as the scalar update's refresh makes it.
+                    for row in &g.rows[d..] {
+                        for l in 0..row.n {
+                            let (j, p) = (row.joint[l], row.parent[l]);
+                            io.models[j] = io.models[p] * io.locals[j];
+                            update_link(rig, io, row.link[l]);
+                        }
+                    }
+                    break;
+                }
                 let (parent, local) = io.row_pose(row, d, above);
                 let parent_world = comp.mul(&parent);
                 // The joint's model translation (`models[p] * locals[j]`), then world.
