@@ -88,8 +88,9 @@ impl VrmState {
         self.simd = simd;
     }
 
-    /// The lane path's view of a frame: the pose and this state's arrays.
-    fn lane_io<'a>(
+    /// What one update reads and writes (the scalar and the lane path): the pose and this
+    /// state's arrays.
+    fn spring_io<'a>(
         &'a mut self,
         component: &Transform,
         dt: f32,
@@ -465,13 +466,13 @@ fn update(
         // models of joints that are not links are left stale: every caller recomputes
         // the whole model pose before reading them.
         let isa = Isa::of(state.simd);
-        let mut io = state.lane_io(component, dt, mode, locals, models);
+        let mut io = state.spring_io(component, dt, mode, locals, models);
         lanes.update(rig, &mut io, isa);
         return true;
     }
     // Model transforms at or above this index are stale (a rotation above them changed).
     let mut stale_from = sk.len();
-    let mut io = state.lane_io(component, dt, mode, locals, models);
+    let mut io = state.spring_io(component, dt, mode, locals, models);
     for (i, l) in rig.links.iter().enumerate() {
         if stale_from <= l.joint {
             refresh(sk, io.locals, io.models, stale_from, l.joint);

@@ -365,6 +365,15 @@ impl SpringLanes {
     /// The scalar update's results for every link (its tails, rotations, and the links'
     /// local rotations and model transforms in the pose; other joints' models are left
     /// as they were, the job recomputes them), computed in the lane type `isa` chose.
+    ///
+    /// A row with few lanes in use costs a whole row: such rows (and the rest of their
+    /// group) run link by link with the scalar update instead, at or below a number of
+    /// lanes measured per lane type on the built-in avatar (`tassel bench demo.vrm --vrm
+    /// fixed --simd auto|avx2|portable`, thresholds 0-4 alternating; `web/bench/ab.mjs`
+    /// for the WebAssembly build): 1 of 16 with AVX-512 (90-95 against 102-122 ns per
+    /// joint-step with none; 2 was slower), 3 of 16 with AVX2 (97 against 119-123), a
+    /// quarter of the portable type's lanes (2 of 8 in WebAssembly: 9-12 % less time per
+    /// frame of the web manager; 3 the same within the noise).
     pub(crate) fn update(&self, rig: &VrmRig, io: &mut SpringIo<'_>, isa: Isa) {
         // SAFETY (both): the function only requires the instructions of its lane type,
         // and `Isa::of` chose that type because the CPU has them.
