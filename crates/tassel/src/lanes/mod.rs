@@ -12,7 +12,8 @@
 //! (every target, WebAssembly included); on x86_64 two explicit types, `avx.rs` (two
 //! 256-bit registers per value) and `avx512.rs` (one 512-bit register), private to this
 //! crate and used only inside functions compiled for their instructions after [`Isa::of`]
-//! found the CPU has them.
+//! found the CPU has them; and `narrow.rs`'s four-lane type, one 128-bit register, for
+//! one character's springs in WebAssembly.
 
 #[cfg(target_arch = "x86_64")]
 pub(crate) mod avx;
@@ -21,7 +22,9 @@ pub(crate) mod avx512;
 #[cfg(all(test, target_arch = "x86_64"))]
 pub(crate) mod check;
 mod isa;
+mod narrow;
 mod types;
 
 pub use isa::{Isa, SimdUse};
+pub(crate) use narrow::F4;
 pub use types::*;

@@ -239,6 +239,8 @@ pub trait Lane:
     /// Which instructions this type's values need (an explicit type's exist only inside
     /// functions compiled with them, after the CPU was found to have them).
     const ISA: super::Isa = super::Isa::Portable;
+    /// How many lanes it holds: [`LANES`], or fewer (the first of [`F`]'s).
+    const WIDTH: usize = LANES;
     /// Every lane `v`.
     fn splat(v: f32) -> Self;
     /// From [`F`] (the same lanes).

@@ -157,7 +157,8 @@ impl VrmRig {
         self.joint_count
     }
 
-    /// How many lane groups (up to eight springs side by side in SIMD lanes) the update
+    /// How many lane groups (up to 16 springs side by side in SIMD lanes on x86_64, 4 in
+    /// WebAssembly, 8 elsewhere) the update
     /// runs in; 0 when the rig's shape keeps it on the scalar update (a spring joint at a
     /// skeleton root, a spring hanging below a simulated joint that is not itself a
     /// spring joint, a centre that a spring moves). Either way the results are the same.

@@ -29,16 +29,30 @@ use crate::dynamics::vrm::{PlacedVrmCollider, VrmMode, VrmRig};
 use crate::lanes::avx::Fa;
 #[cfg(target_arch = "x86_64")]
 use crate::lanes::avx512::Fz;
-use crate::lanes::{rotation_arc_from_lanes, Lane, Mask, Trs, F, LANES, M, Q, V3};
+use crate::lanes::{rotation_arc_from_lanes, Lane, Mask, Trs, F, F4, LANES, M, Q, V3};
 use crate::lanes::{Isa, SimdUse};
 use crate::math::{normalize_or, Transform};
 use crate::pose::compose_joints;
 use crate::skeleton::Skeleton;
 use glam::{Quat, Vec3};
 
+/// How many springs a group puts side by side: [`LANES`], but four in WebAssembly, where
+/// [`LANES`] (eight) is two `v128` registers and the portable type pays for all eight
+/// lanes in a row whatever its springs fill; four are one register ([`F4`]). Measured
+/// on the built-in avatar (13 springs, 44 joints; `web/bench/ab.mjs`): see
+/// [`SpringLanes::update`].
+pub(crate) const SPRING_LANES: usize = if cfg!(target_arch = "wasm32") {
+    4
+} else {
+    LANES
+};
+
 /// The rig's links as lane rows, compiled once with the rig.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct SpringLanes {
+    /// Columns per group at most ([`SPRING_LANES`]): four or fewer run in [`F4`] where the
+    /// portable type runs.
+    width: usize,
     groups: Vec<Group>,
     /// Joints below a link that are not links, in skeleton order: the update leaves their
     /// models stale.
@@ -157,6 +171,12 @@ impl SpringLanes {
     /// The plan for `rig`, or `None` where the lanes cannot give the scalar order's
     /// results (see the module's documentation) or there is nothing to simulate.
     pub(crate) fn new(sk: &Skeleton, rig: &VrmRig) -> Option<SpringLanes> {
+        SpringLanes::with_width(sk, rig, SPRING_LANES)
+    }
+
+    /// [`SpringLanes::new`] with at most `width` (1..=[`LANES`]) columns a group.
+    pub(crate) fn with_width(sk: &Skeleton, rig: &VrmRig, width: usize) -> Option<SpringLanes> {
+        let width = width.clamp(1, LANES);
         let links = &rig.links;
         if rig.has_limits() {
             // Limits run in the scalar update (several springs side by side would apply
@@ -229,7 +249,7 @@ impl SpringLanes {
             let head = &columns[order[start]];
             let mut merged = Merged::new(colliders_of(head.links[0]));
             let mut end = start + 1;
-            while end < order.len() && end - start < LANES {
+            while end < order.len() && end - start < width {
                 let c = &columns[order[end]];
                 let l = c.links[0];
                 if c.level != head.level
@@ -274,6 +294,7 @@ impl SpringLanes {
             .collect();
         let rows: usize = groups.iter().map(|g: &Group| g.rows.len()).sum();
         Some(SpringLanes {
+            width,
             groups,
             below,
             step_read,
@@ -372,8 +393,15 @@ impl SpringLanes {
     /// fixed --simd auto|avx2|portable`, thresholds 0-4 alternating; `web/bench/ab.mjs`
     /// for the WebAssembly build): 1 of 16 with AVX-512 (90-95 against 102-122 ns per
     /// joint-step with none; 2 was slower), 3 of 16 with AVX2 (97 against 119-123), a
-    /// quarter of the portable type's lanes (2 of 8 in WebAssembly: 9-12 % less time per
-    /// frame of the web manager; 3 the same within the noise).
+    /// quarter of the portable type's lanes natively (a test path there).
+    ///
+    /// A plan of at most four columns a group ([`SPRING_LANES`] in WebAssembly) runs in
+    /// the four-lane type [`F4`] where the portable type would run, with rows of one lane
+    /// in use link by link: on the built-in avatar its 13 springs take four groups of
+    /// one `v128` register each instead of two of eight lanes (two registers) with rows
+    /// of two scalar (the previous WebAssembly plan: 9-12 % less time per frame than
+    /// none). `web/bench/ab.mjs 10|1 fixed manager`, both orders, one process: 4-15 %
+    /// less time per frame of the web manager than that plan.
     pub(crate) fn update(&self, rig: &VrmRig, io: &mut SpringIo<'_>, isa: Isa) {
         // SAFETY (both): the function only requires the instructions of its lane type,
         // and `Isa::of` chose that type because the CPU has them.
@@ -385,7 +413,15 @@ impl SpringLanes {
             Isa::Portable => {}
         }
         let _ = isa;
+        if self.width <= 4 {
+            return self.update_narrow(rig, io);
+        }
         self.update_baseline(rig, io)
+    }
+
+    #[inline(never)]
+    fn update_narrow(&self, rig: &VrmRig, io: &mut SpringIo<'_>) {
+        self.update_lanes::<F4>(rig, io, 1)
     }
 
     #[inline(never)]
@@ -450,7 +486,7 @@ impl SpringLanes {
                 let position = comp.transform_point(own_t);
                 let mut stored = (V3::splat(Vec3::ZERO), V3::splat(Vec3::ZERO));
                 let mut length = F::splat(0.0);
-                for l in 0..LANES {
+                for l in 0..T::WIDTH {
                     let i = row.link[l];
                     stored.0.set(l, io.current_tail[i]);
                     stored.1.set(l, io.prev_tail[i]);
@@ -471,7 +507,7 @@ impl SpringLanes {
                 let mut length = T::of(length);
                 if three_vrm {
                     let mut stale = V3::splat(Vec3::ZERO);
-                    for l in 0..LANES {
+                    for l in 0..T::WIDTH {
                         stale.set(l, io.stale_tail[row.link[l]]);
                     }
                     let measured = (V3::<T>::of(stale) - position).length();
@@ -727,7 +763,134 @@ fn placed_in_lanes(p: &PlacedVrmCollider) -> Placed {
 
 #[cfg(test)]
 mod tests {
-    use super::{supersequence, Merged};
+    use super::{supersequence, Merged, SpringLanes};
+    use crate::dynamics::vrm::{
+        VrmCollider, VrmColliderGroup, VrmMode, VrmOptions, VrmShape, VrmSpringBones,
+    };
+    use crate::dynamics::RigSettings;
+    use crate::lanes::SimdUse;
+    use crate::{CharacterRig, CharacterSim, Transform};
+    use glam::{Quat, Vec3};
+    use std::sync::Arc;
+
+    /// The built-in avatar's springs with more of the plan in use: the ponytail and the
+    /// locks keep their tails in the head's space (a centre), the skirt also has a plane
+    /// under the hips and an inside sphere around them (every shape, inside and out).
+    fn avatar_bones() -> (crate::Skeleton, VrmSpringBones) {
+        let c = crate::builtin::character();
+        let sk = c.skeleton.clone();
+        let mut b = crate::builtin::avatar::spring_bones(&c);
+        let head = sk.find("head").unwrap();
+        let hips = sk.find("hips").unwrap();
+        for s in &mut b.springs {
+            if s.name == "ponytail" || s.name.starts_with("lock") {
+                s.center = Some(head);
+            }
+        }
+        for shape in [
+            VrmShape::Plane {
+                offset: Vec3::new(0.0, -0.55, 0.0),
+                normal: Vec3::Y,
+            },
+            VrmShape::Sphere {
+                offset: Vec3::ZERO,
+                radius: 0.5,
+                inside: true,
+            },
+        ] {
+            b.colliders.push(VrmCollider { joint: hips, shape });
+            b.collider_groups.push(VrmColliderGroup {
+                name: format!("extra {}", b.colliders.len()),
+                colliders: vec![b.colliders.len() - 1],
+            });
+            let g = b.collider_groups.len() - 1;
+            for s in b.springs.iter_mut().filter(|s| s.name.starts_with("skirt")) {
+                s.collider_groups.push(g);
+            }
+        }
+        (sk, b)
+    }
+
+    /// The four-lane plan (WebAssembly's) run natively in the four-lane type against the
+    /// scalar update: every local and model transform the same bits after every frame, in
+    /// every mode, through a sway, a pause, a hitch and a teleport.
+    #[test]
+    fn four_lanes_a_group_give_the_scalar_bits() {
+        let (sk, bones) = avatar_bones();
+        let modes = [
+            (VrmMode::Spec, 60.0),
+            (VrmMode::ThreeVrm, 60.0),
+            (VrmMode::Fixed, 60.0),
+            (VrmMode::Fixed, 90.0),
+        ];
+        for (mode, step_rate) in modes {
+            let options = VrmOptions {
+                mode,
+                step_rate,
+                teleport_distance: 2.0,
+                ..Default::default()
+            };
+            let rig = CharacterRig::with_vrm(sk.clone(), &RigSettings::default(), &bones, options)
+                .unwrap();
+            let mut narrow = rig.clone();
+            let plan = SpringLanes::with_width(&sk, &narrow.vrm, 4).expect("a lane plan");
+            assert!(plan.groups.iter().all(|g| g.rows.iter().all(|r| r.n <= 4)));
+            assert!(plan.groups.len() >= 4, "13 springs, four a group");
+            assert!(
+                plan.groups.iter().any(|g| g.masks.is_some()),
+                "a merged list"
+            );
+            assert!(plan.groups.iter().any(|g| g.center.is_some()), "a centre");
+            narrow.vrm.lanes = Some(plan);
+            let mut reference = CharacterSim::from_rig(Arc::new(rig));
+            reference.set_simd(SimdUse::Scalar);
+            let mut sim = CharacterSim::from_rig(Arc::new(narrow));
+            sim.set_simd(SimdUse::Portable);
+            let swing = sk.find("hips").unwrap();
+            let mut locals = sk.rest().to_vec();
+            let mut turned = 0.0f32;
+            for f in 0..400 {
+                let t = f as f32 / 60.0;
+                locals.copy_from_slice(sk.rest());
+                locals[swing].rotation =
+                    sk.rest()[swing].rotation * Quat::from_rotation_x(0.6 * (3.0 * t + 1.0).sin());
+                let jump = if f >= 300 { 10.0 } else { 0.0 };
+                let root = Transform::from_translation_rotation(
+                    Vec3::new((3.0 * t).sin() * 0.5 + jump, 0.1 * (5.0 * t).sin(), t),
+                    Quat::from_rotation_y(0.8 * (2.0 * t).sin()),
+                );
+                let dt = match f {
+                    100 => 0.0,
+                    200 => 0.25,
+                    _ => 1.0 / 60.0,
+                };
+                let want = reference.frame(&locals, root, dt).unwrap().clone();
+                let got = sim.frame(&locals, root, dt).unwrap();
+                for j in 0..sk.len() {
+                    let bits = |t: &Transform| {
+                        (
+                            t.translation.to_array().map(f32::to_bits),
+                            t.rotation.to_array().map(f32::to_bits),
+                            t.scale.to_array().map(f32::to_bits),
+                        )
+                    };
+                    assert_eq!(
+                        (bits(&got.locals[j]), bits(&got.models[j])),
+                        (bits(&want.locals[j]), bits(&want.models[j])),
+                        "{mode:?} at {step_rate} Hz: frame {f}, joint '{}'",
+                        sk.name(j)
+                    );
+                }
+                for l in &reference.vrm().links {
+                    let turn = want.locals[l.joint]
+                        .rotation
+                        .angle_between(l.rest_local.rotation);
+                    turned = turned.max(turn);
+                }
+            }
+            assert!(turned > 0.05, "{mode:?}: the springs barely moved");
+        }
+    }
 
     /// Every pair of short lists over three colliders (repeats allowed): the result holds
     /// each list at its places, in order, and is as long as the two less their longest
