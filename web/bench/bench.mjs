@@ -12,8 +12,8 @@ import { runBench } from './core.mjs';
 
 const args = process.argv.slice(2);
 const file = args.length && !/^[0-9,]+$/.test(args[0]) ? args.shift() : null;
-const frames = Number(args[0] ?? 200);
-const runs = Number(args[1] ?? 7);
+const frames = Number(args[0] ?? 400);
+const runs = Number(args[1] ?? 11);
 const counts = (args[2] ?? (file === 'avatar' ? '1,10,100' : '1,100')).split(',').map(Number);
 let bytes;
 if (file === 'avatar') {

@@ -7,7 +7,7 @@ import { start } from '../test/serve.mjs';
 const args = process.argv.slice(2);
 const avatar = args[0] === 'avatar' ? args.shift() : null;
 const frames = Number(args[0] ?? 400);
-const runs = Number(args[1] ?? 7);
+const runs = Number(args[1] ?? 11);
 const server = await start(0);
 const browser = await chromium.launch({
   executablePath: process.env.CHROMIUM ?? '/usr/bin/chromium',

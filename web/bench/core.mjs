@@ -5,8 +5,9 @@
 // character's manager.update(1/60), or one TasselCrowd.update(1/60) for all — Tassel's
 // including the transfer of transforms from and to the three.js objects. Runs are
 // interleaved (three-vrm, Tassel three-vrm mode, Tassel fixed, the crowd in both, again...)
-// and each figure is the median over runs, in ns per joint-step (a joint-step: one
-// simulated joint in one update).
+// and each figure is the median over runs (11 runs of 400/√N frames for N characters by
+// default: runs of a few milliseconds moved the medians by a fifth on a shared machine),
+// in ns per joint-step (a joint-step: one simulated joint in one update).
 import { CHAINS, JOINTS_PER_CHAIN, springRigGlb } from './rig.mjs';
 
 const RIG_JOINTS = CHAINS * JOINTS_PER_CHAIN;
@@ -79,7 +80,7 @@ function median(v) {
   return s[s.length >> 1];
 }
 
-export async function runBench({ counts = [1, 100], frames = 200, runs = 7, log = console.log, ...ctx }) {
+export async function runBench({ counts = [1, 100], frames = 400, runs = 11, log = console.log, ...ctx }) {
   const kinds = Object.keys(KINDS);
   const results = [];
   // Per joint: the spring joints three-vrm's manager steps (the rig's 128 by construction).
