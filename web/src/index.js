@@ -301,6 +301,65 @@ class BoneParts {
     r[14] = a31 * tx + a32 * ty + a33 * tz + a34;
     r[15] = a41 * tx + a42 * ty + a43 * tz + a44;
   }
+
+  /** Refreshes part `k`'s `matrix` and `matrixWorld` from its own local transform and its
+   *  parent's `matrixWorld`, as three's `updateWorldMatrix(false, false)` does, without
+   *  writing the local transform: an object between the written bones and the scene
+   *  that nothing writes. Through three itself where its flags ask for something else
+   *  (`matrixAutoUpdate` or `matrixWorldAutoUpdate` off, a `pivot`). */
+  refresh(k) {
+    // (The matrices as `write` makes them, written out again: one function for both, called
+    // from each, made the written bones 4-10 % slower, measured with bench/ab.mjs.)
+    const o = this.object[k];
+    if (o.matrixAutoUpdate !== true || o.matrixWorldAutoUpdate !== true || (o.pivot ?? null) !== null) {
+      o.updateWorldMatrix(false, false);
+      return;
+    }
+    o.matrixWorldNeedsUpdate = false;
+    const p = this.p[k], q = this.q[k], s = this.s[k];
+    const tx = p.x, ty = p.y, tz = p.z, x = q._x, y = q._y, z = q._z, w = q._w, sx = s.x, sy = s.y, sz = s.z;
+    // As Matrix4.compose.
+    const m = this.m[k];
+    const x2 = x + x, y2 = y + y, z2 = z + z;
+    const xx = x * x2, xy = x * y2, xz = x * z2;
+    const yy = y * y2, yz = y * z2, zz = z * z2;
+    const wx = w * x2, wy = w * y2, wz = w * z2;
+    const m0 = (1 - (yy + zz)) * sx, m1 = (xy + wz) * sx, m2 = (xz - wy) * sx;
+    const m4 = (xy - wz) * sy, m5 = (1 - (xx + zz)) * sy, m6 = (yz + wx) * sy;
+    const m8 = (xz + wy) * sz, m9 = (yz - wx) * sz, m10 = (1 - (xx + yy)) * sz;
+    m[0] = m0; m[1] = m1; m[2] = m2; m[3] = 0;
+    m[4] = m4; m[5] = m5; m[6] = m6; m[7] = 0;
+    m[8] = m8; m[9] = m9; m[10] = m10; m[11] = 0;
+    m[12] = tx; m[13] = ty; m[14] = tz; m[15] = 1;
+    const r = this.w[k];
+    const a = this.pw[k];
+    if (a === null) {
+      for (let i = 0; i < 16; i++) r[i] = m[i];
+      return;
+    }
+    // As Matrix4.multiplyMatrices(parent.matrixWorld, matrix), the local matrix's last
+    // row being (0 0 0 1).
+    const a11 = a[0], a12 = a[4], a13 = a[8], a14 = a[12];
+    const a21 = a[1], a22 = a[5], a23 = a[9], a24 = a[13];
+    const a31 = a[2], a32 = a[6], a33 = a[10], a34 = a[14];
+    const a41 = a[3], a42 = a[7], a43 = a[11], a44 = a[15];
+    r[0] = a11 * m0 + a12 * m1 + a13 * m2;
+    r[1] = a21 * m0 + a22 * m1 + a23 * m2;
+    r[2] = a31 * m0 + a32 * m1 + a33 * m2;
+    r[3] = a41 * m0 + a42 * m1 + a43 * m2;
+    r[4] = a11 * m4 + a12 * m5 + a13 * m6;
+    r[5] = a21 * m4 + a22 * m5 + a23 * m6;
+    r[6] = a31 * m4 + a32 * m5 + a33 * m6;
+    r[7] = a41 * m4 + a42 * m5 + a43 * m6;
+    r[8] = a11 * m8 + a12 * m9 + a13 * m10;
+    r[9] = a21 * m8 + a22 * m9 + a23 * m10;
+    r[10] = a31 * m8 + a32 * m9 + a33 * m10;
+    r[11] = a41 * m8 + a42 * m9 + a43 * m10;
+    r[12] = a11 * tx + a12 * ty + a13 * tz + a14;
+    r[13] = a21 * tx + a22 * ty + a23 * tz + a24;
+    r[14] = a31 * tx + a32 * ty + a33 * tz + a34;
+    r[15] = a41 * tx + a42 * ty + a43 * tz + a44;
+  }
 }
 
 /** The module's `size_t` list (32 bits in wasm32) that `fill(ptr, count)` writes. */
@@ -333,10 +392,13 @@ function parentsFirst(joints, depths) {
 
 /** The order a character's bones are written in, parents first: entries `k >= 0` write
  *  `parts`' k-th joint (given in `order`); with `world`, entries `-1 - i` refresh the
- *  matrixWorld of `refresh[i]`, an object between a written bone and the scene that is not
- *  written itself (a spring chain's non-simulated parent and its ancestors), so that every
- *  matrixWorld written is made from its parent's of this frame, not the last render's.
- *  Taken from the objects' parents when the character is made. */
+ *  matrixWorld of `refresh`'s i-th object (`refresh`: BoneParts), an object between a
+ *  written bone and the scene that is not written itself (a spring chain's non-simulated
+ *  parent and its ancestors), so that every matrixWorld written is made from its parent's
+ *  of this frame, not the last render's. Taken from the objects' parents when the
+ *  character is made. (Refreshed in BoneParts rather than by three's generic
+ *  updateWorldMatrix: the 10 ancestors of the built-in avatar were 4 % of the web
+ *  manager's frame through three.) */
 function writePlan(parts, order, scene, world) {
   const written = new Set(parts.object.filter((o) => o));
   const refresh = [];
@@ -362,7 +424,7 @@ function writePlan(parts, order, scene, world) {
   });
   refresh.forEach((o, i) => entries.push({ e: -1 - i, depth: depth(o), rank: -1 }));
   entries.sort((a, b) => a.depth - b.depth || a.rank - b.rank);
-  return { plan: Int32Array.from(entries, (x) => x.e), refresh };
+  return { plan: Int32Array.from(entries, (x) => x.e), refresh: new BoneParts(refresh, refresh.map((_, i) => i)) };
 }
 
 /** Writes a character's bones by its plan (see writePlan): joint k from `v[base + at(k)..]`. */
@@ -370,7 +432,7 @@ function writeBones(parts, { plan, refresh }, v, base, at, syncRotation, world, 
   for (let i = 0; i < plan.length; i++) {
     const e = plan[i];
     if (e >= 0) parts.write(e, v, base + at[e], syncRotation, world, turnOnly);
-    else refresh[-1 - e].updateWorldMatrix(false, false);
+    else refresh.refresh(-1 - e);
   }
 }
 

@@ -83,6 +83,54 @@ async function runEvents() {
   return bad;
 }
 failures += await runEvents();
+// The objects between the written bones and the scene (the built-in avatar's hips,
+// spine, chest, head, arm...: refreshed by the manager, not written): with the spine and
+// the left arm animated every frame, every such object's matrixWorld after an update is
+// what three's own scene.updateMatrixWorld(true) then makes of the same local transforms;
+// an ancestor with matrixAutoUpdate off keeps the matrix the app gave it, as in three.
+async function runAncestors() {
+  const bytes = await builtinAvatar();
+  const { gltf } = await loadGltfBytes(bytes);
+  const m = await TasselSpringBoneManager.fromGLTF(gltf, bytes, { mode: 'fixed' });
+  const named = (n) => gltf.scene.getObjectByName(n);
+  const spine = named('spine'), arm = named('upper_arm_l'), hand = named('hand_l');
+  let bad = 0, worst = 0, compared = 0;
+  const ok = (c, what) => { if (!c) { bad++; console.log(`FAILED: ${what}`); } };
+  ok(spine && arm && hand, 'the avatar has spine, upper_arm_l and hand_l');
+  // What the manager answers for: the scene, the bones it writes and every object between
+  // them (the rest of the tree is left to the renderer, as three-vrm leaves it).
+  const objects = new Set([gltf.scene]);
+  for (const b of m.bones) for (let o = b; o && !objects.has(o); o = o.parent) objects.add(o);
+  ok(objects.size > m.bones.length + 5, `ancestors to refresh: ${objects.size - m.bones.length}`);
+  for (let f = 0; f < 60; f++) {
+    spine.quaternion.setFromAxisAngle(new THREE.Vector3(1, 0, 0), 0.4 * Math.sin(f / 9));
+    arm.quaternion.setFromAxisAngle(new THREE.Vector3(0, 0, 1), 0.8 * Math.sin(f / 7));
+    if (f === 59) {
+      // The app takes the hand's matrix over (on the last frame: later frames would leave
+      // its matrixWorld as three's updateWorldMatrix leaves an object whose matrix is not
+      // updated automatically, which updateMatrixWorld(true) forces).
+      hand.matrixAutoUpdate = false;
+      hand.matrix.makeTranslation(0, -0.1, 0.02);
+      hand.matrixWorldNeedsUpdate = true;
+    }
+    gltf.scene.position.x = 0.3 * Math.sin(f / 5);
+    gltf.scene.updateMatrix();
+    ok(m.update(1 / 60), `frame ${f}: ${m.lastError}`);
+    const got = [...objects].map((o) => [...o.matrixWorld.elements]);
+    const handMatrix = [...hand.matrix.elements];
+    gltf.scene.updateMatrixWorld(true);
+    [...objects].forEach((o, i) => {
+      for (let c = 0; c < 16; c++) worst = Math.max(worst, Math.abs(got[i][c] - o.matrixWorld.elements[c]));
+      compared++;
+    });
+    ok(hand.matrix.elements.every((v, c) => v === handMatrix[c]), `frame ${f}: the hand's own matrix was kept`);
+  }
+  ok(worst <= 1e-6, `every matrixWorld within 1e-6 of three's: ${worst}`);
+  m.dispose();
+  console.log(bad ? 'ancestors: FAILED' : `ancestors: ${compared} object-frames within ${worst.toExponential(1)} of three's updateMatrixWorld, the app's own matrix kept`);
+  return bad;
+}
+failures += await runAncestors();
 failures += await runShareRig({ loadGltfBytes, TasselSpringBoneManager, loadTassel, builtinAvatar, log: console.log });
 console.log(failures ? `node parity: ${failures} FAILED` : `node parity: all passed (${files.length} files)`);
 process.exit(failures ? 1 : 0);
