@@ -292,6 +292,9 @@ impl VrmJob<'_> {
         // Fixed mode: whether this frame's last step ended on the frame, on its pose and
         // colliders (then its rotations are the output, pushed out already).
         let mut on_frame = false;
+        // Whether `prev_locals` holds this frame's animated pose already (fixed mode's
+        // on-frame step took it before turning the links in place).
+        let mut prev_taken = false;
         // Whether a reset wrote `models` (its lazy refresh's root rule: the output pose is
         // composed again whole).
         let mut was_reset = state.needs_reset;
@@ -308,7 +311,8 @@ impl VrmJob<'_> {
                     }
                 }
                 VrmMode::Fixed => {
-                    on_frame = run_fixed(skeleton, rig, state, dt, locals, models, models_given)
+                    on_frame = run_fixed(skeleton, rig, state, dt, locals, models, models_given);
+                    prev_taken = on_frame;
                 }
             }
         }
@@ -320,16 +324,18 @@ impl VrmJob<'_> {
             lanes_ran = false;
             on_frame = false;
             was_reset = true;
+            prev_taken = false;
         }
-        // A last step on this frame's own pose in lanes wrote the output's models of the
-        // links (the joints below them are left to `refresh_below`, as in the spec
-        // modes). The scalar step's models are its lazy refresh's, which takes a root
-        // link's local as its model: the whole pose is composed again below.
+        // A last step on this frame's own pose, in place, in lanes wrote the output's
+        // models of the links (the joints below them are left to `refresh_below`, as in
+        // the spec modes). The scalar step's models are its lazy refresh's, which takes a
+        // root link's local as its model: the whole pose is composed again below.
         if on_frame && lane_plan(rig, state).is_some() {
-            models.copy_from_slice(&state.step_models);
             lanes_ran = true;
         }
-        state.prev_locals.copy_from_slice(locals);
+        if !prev_taken {
+            state.prev_locals.copy_from_slice(locals);
+        }
         state.prev_component = component;
         // Output: the last step's rotations; in fixed mode, unless that step ended on
         // this frame, an output step: the springs carried from the last step to the
@@ -669,15 +675,17 @@ fn refresh(sk: &Skeleton, locals: &[Transform], models: &mut [Transform], from: 
 /// Fixed mode: whole steps of `1/step_rate` up to now, each with the animated pose and the
 /// character transform interpolated to its time. Time left over within [`ON_FRAME`](crate::dynamics::path::ON_FRAME) of a step is
 /// dropped, and a last step that then ends on the frame takes the frame's own pose
-/// (`locals`, and `models` when `models_given` says it is their model pose): returns
-/// whether it did, so that its rotations are the frame's output as they are.
+/// (`locals`, and `models` when `models_given` says it is their model pose), stepping on
+/// them in place after keeping `locals` as `prev_locals`: returns whether it did, so that
+/// its rotations (written into `locals` already, with the links' models) are the frame's
+/// output as they are.
 fn run_fixed(
     sk: &Skeleton,
     rig: &VrmRig,
     state: &mut VrmState,
     dt: f32,
-    locals: &[Transform],
-    models: &[Transform],
+    locals: &mut [Transform],
+    models: &mut [Transform],
     models_given: bool,
 ) -> bool {
     let opts = &rig.options;
@@ -686,6 +694,16 @@ fn run_fixed(
     for k in 1..=clock.steps {
         let w = clock.end(k);
         let comp = state.path.at(w);
+        if k == clock.steps && clock.on_frame() && models_given {
+            // The last step ends on the frame: it steps on the frame's own pose as given,
+            // in place (it turns the links and writes their models, as the output would),
+            // after this frame's animated pose is kept for the next frame's steps. The
+            // same values as a step on copies, without the three copies.
+            state.prev_locals.copy_from_slice(locals);
+            place_colliders(rig, state, &comp, models);
+            update(sk, rig, state, &comp, h, VrmMode::Fixed, locals, models);
+            break;
+        }
         let mut step_locals = std::mem::take(&mut state.step_locals);
         let mut step_models = std::mem::take(&mut state.step_models);
         if w >= 1.0 && models_given {
@@ -699,13 +717,13 @@ fn run_fixed(
                     // Only what the lane update and the colliders read of the step's pose
                     // (the same values where they read it).
                     let isa = Isa::of(state.simd);
-                    let frames = (&state.prev_locals[..], locals);
+                    let frames = (&state.prev_locals[..], &*locals);
                     lanes.step_pose(sk, frames, w, &mut step_locals, &mut step_models, isa);
                 }
                 None => {
                     for (s, (a, b)) in step_locals
                         .iter_mut()
-                        .zip(state.prev_locals.iter().zip(locals))
+                        .zip(state.prev_locals.iter().zip(locals.iter()))
                     {
                         *s = if w >= 1.0 { *b } else { a.lerp(b, w) };
                     }
