@@ -400,7 +400,7 @@ impl SpringLanes {
     /// in use link by link: on the built-in avatar its 13 springs take four groups of
     /// one `v128` register each instead of two of eight lanes (two registers) with rows
     /// of two scalar (the previous WebAssembly plan: 9-12 % less time per frame than
-    /// none). `web/bench/ab.mjs 10|1 fixed manager`, both orders, one process: 4-15 %
+    /// none). `web/bench/ab.mjs 10|1 fixed manager`, both orders, one process: 2-14 %
     /// less time per frame of the web manager than that plan.
     pub(crate) fn update(&self, rig: &VrmRig, io: &mut SpringIo<'_>, isa: Isa) {
         // SAFETY (both): the function only requires the instructions of its lane type,
