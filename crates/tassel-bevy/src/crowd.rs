@@ -600,9 +600,10 @@ impl Crowds {
     /// Writes every tagged, written bone of a member that stepped, from its kind's output
     /// rotations, keeping the view of the last kind it met. On one thread: in the compute
     /// pool's threads (`par_iter_mut`) this pass took 0.56–0.86 ms a frame for 1 000
-    /// avatars with two threads against 0.35 ms with one, and 0.37–0.43 ms on one thread
-    /// beside two for the solve (`bench/bevy_vrm1_vs_tassel -- 1000 --avatar --threads
-    /// 2`, two builds alternating): a rotation store per bone is too little work to share.
+    /// avatars with two threads against 0.35–0.40 ms with one; as a plain loop it takes
+    /// 0.24–0.43 ms with two threads for the solve (`bench/bevy_vrm1_vs_tassel -- 1000
+    /// --avatar --threads 2`, two builds alternating, then four runs): a rotation store
+    /// per bone is too little work to share.
     pub(crate) fn write_tagged(
         &mut self,
         bones: &mut Query<(&CrowdBone, &mut BevyTransform), With<WrittenBone>>,
