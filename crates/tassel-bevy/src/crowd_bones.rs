@@ -7,9 +7,9 @@
 //! read pass walks the tagged bones whose `Transform` changed since the step system last
 //! ran (Bevy's change ticks: the plugin's own writes are not changes to it, so a bone no
 //! animation drives keeps its last animated pose as input, as the per-entity path's
-//! comparison with what the plugin wrote does); the write pass walks the written bones in
-//! the pool's threads and sets each one's rotation from the crowd's output, gathered once
-//! per frame member after member. Both walk Bevy's tables in order, and the read touches
+//! comparison with what the plugin wrote does); the write pass walks the written bones on
+//! one thread and sets each one's rotation from the crowd's output, gathered once per
+//! frame member after member. Both walk Bevy's tables in order, and the read touches
 //! nothing of a bone no animation moved.
 //!
 //! The tags arrive with the commands applied after the step system, so a member reads and

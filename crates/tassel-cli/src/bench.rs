@@ -56,6 +56,13 @@ pub struct Args {
     /// character, the same threads) in the same run and print the ratio.
     #[arg(long, requires = "crowd")]
     compare: bool,
+    /// With --crowd: time the crowd as a game's frame leaves it: each character reads
+    /// its own pose buffer, and 64 MiB are written before every frame (not timed), so
+    /// the crowd's state and input come from memory rather than the caches (a game
+    /// engine's frame touches far more than the crowd between two steps: the Bevy bench's
+    /// crowd is about this slow). The crowd path only.
+    #[arg(long, requires = "crowd")]
+    cold: bool,
     /// Which code runs the solvers that have a lane path (VRM springs, twin chains, the
     /// cloth's contact tests; with --crowd, the crowd): `scalar` is the readable
     /// reference (the same bits, slower; one character only), `portable` lanes without
@@ -295,6 +302,9 @@ fn crowd(a: &Args, n: usize) -> Result<(), String> {
     }
     let threads = a.threads.min(n);
     let frames = a.frames.max(1);
+    if a.cold && a.compare {
+        return Err("--cold times the crowd path only: leave out --compare".into());
+    }
     // A file's character steps as a VRM crowd when its solvers are VRM springs alone,
     // else one `CharacterSim` each.
     let file_crowd = match &a.file {
@@ -306,6 +316,11 @@ fn crowd(a: &Args, n: usize) -> Result<(), String> {
         None => None,
     };
     let crowd_path = !a.cloth && (a.file.is_none() || file_crowd.is_some());
+    if a.cold && !crowd_path {
+        return Err(
+            "--cold times the crowd path only (VRM springs alone, or the bench chains)".into(),
+        );
+    }
     if crowd_path && a.simd == SimdBench::Scalar {
         return Err(
             "--simd scalar: the crowd path has only lanes (its scalar reference is one \
@@ -331,7 +346,15 @@ fn crowd(a: &Args, n: usize) -> Result<(), String> {
             what,
             joints,
             t,
-            format!("crowd path, {}", a.simd.describe()),
+            format!(
+                "crowd path, {}{}",
+                a.simd.describe(),
+                if a.cold {
+                    "; cold: a pose buffer per character, 64 MiB written before every frame (not timed)"
+                } else {
+                    ""
+                }
+            ),
         )
     } else {
         let (what, joints, t) = reference.clone().expect("timed above");
@@ -373,31 +396,88 @@ fn chain_crowd(
     let (_, joints, what) = character(a)?;
     let (sk, settings) = bench_chains(a, 16, 8, 8);
     let rig = ChainRig::new(&sk, &settings).map_err(|e| e.to_string())?;
-    let rest = sk.rest().to_vec();
+    let mut poses = Poses::new(a, n, sk.rest())?;
     let mut crowd = ChainCrowd::new(Arc::new(sk), Arc::new(rig)).map_err(|e| e.to_string())?;
     crowd.set_simd(a.simd.simd_use());
     for _ in 0..n {
         crowd.add();
     }
     time_crowd(a, threads, frames, what, joints, |f| {
+        poses.sweep();
+        let start = Instant::now();
         crowd
             .frame(1.0 / 60.0, |i| CrowdPose {
                 transform: motion(f, i as f32 * a.phase_step),
-                locals: &rest,
+                locals: poses.of(i),
             })
-            .map_err(|e| e.to_string())
+            .map_err(|e| e.to_string())?;
+        Ok(start.elapsed().as_secs_f64())
     })
 }
 
-/// Times `frame(f)` for frames `f` = 0, 1, ... on a pool of `threads`: seconds per frame
-/// (median over the runs), with what was run.
+/// The crowd's animated poses: the rest pose shared by every character, or with
+/// `--cold` a copy per character and a buffer to sweep the caches with.
+struct Poses {
+    rest: Vec<Transform>,
+    own: Vec<Transform>,
+    sweep: Vec<u64>,
+}
+
+impl Poses {
+    /// Bytes `--cold` writes before every frame: twice the last-level cache of this
+    /// machine (32 MiB) and of most desktop processors.
+    const SWEEP_BYTES: usize = 64 << 20;
+    /// The most the per-character poses of `--cold` may take.
+    const MAX_OWN_BYTES: usize = 2 << 30;
+
+    fn new(a: &Args, n: usize, rest: &[Transform]) -> Result<Poses, String> {
+        let mut p = Poses {
+            rest: rest.to_vec(),
+            own: Vec::new(),
+            sweep: Vec::new(),
+        };
+        if a.cold {
+            let bytes = n
+                .saturating_mul(rest.len())
+                .saturating_mul(std::mem::size_of::<Transform>());
+            if bytes > Self::MAX_OWN_BYTES {
+                return Err(format!(
+                    "--cold: {n} characters' own poses would take {} MiB (at most {} MiB)",
+                    bytes >> 20,
+                    Self::MAX_OWN_BYTES >> 20
+                ));
+            }
+            p.own = (0..n).flat_map(|_| rest.iter().copied()).collect();
+            p.sweep = vec![0; Self::SWEEP_BYTES / 8];
+        }
+        Ok(p)
+    }
+
+    /// Character `i`'s pose.
+    fn of(&self, i: usize) -> &[Transform] {
+        let n = self.rest.len();
+        self.own.get(i * n..(i + 1) * n).unwrap_or(&self.rest)
+    }
+
+    /// With `--cold`: writes the sweep buffer (pushing the crowd out of the caches).
+    fn sweep(&mut self) {
+        for (k, x) in self.sweep.iter_mut().enumerate() {
+            *x = x.wrapping_add(k as u64);
+        }
+        std::hint::black_box(&mut self.sweep);
+    }
+}
+
+/// Times frames `f` = 0, 1, ... on a pool of `threads` (`frame(f)` runs a frame and
+/// returns the seconds it took, leaving out any preparation): seconds per frame (median
+/// over the runs), with what was run.
 fn time_crowd(
     a: &Args,
     threads: usize,
     frames: usize,
     what: String,
     joints: usize,
-    mut frame: impl FnMut(usize) -> Result<(), String> + Send,
+    mut frame: impl FnMut(usize) -> Result<f64, String> + Send,
 ) -> Result<(String, usize, f64), String> {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
@@ -405,15 +485,15 @@ fn time_crowd(
         .map_err(|e| e.to_string())?;
     let mut first_frame = 0usize;
     let one_run = |frames: usize| -> Result<f64, String> {
-        let start = Instant::now();
-        pool.install(|| -> Result<(), String> {
+        let seconds = pool.install(|| -> Result<f64, String> {
+            let mut seconds = 0.0;
             for f in first_frame..first_frame + frames {
-                frame(f)?;
+                seconds += frame(f)?;
             }
-            Ok(())
+            Ok(seconds)
         })?;
         first_frame += frames;
-        Ok(start.elapsed().as_secs_f64() / frames as f64)
+        Ok(seconds / frames as f64)
     };
     let samples = sorted_samples(a.runs, frames, one_run)?;
     Ok((what, joints, samples[samples.len() / 2]))
@@ -446,19 +526,22 @@ fn crowd_of(
     sk: tassel::Skeleton,
     rig: VrmRig,
 ) -> Result<(String, usize, f64), String> {
-    let rest = sk.rest().to_vec();
+    let mut poses = Poses::new(a, n, sk.rest())?;
     let mut crowd = VrmCrowd::new(Arc::new(sk), Arc::new(rig)).map_err(|e| e.to_string())?;
     crowd.set_simd(a.simd.simd_use());
     for _ in 0..n {
         crowd.add();
     }
     time_crowd(a, threads, frames, what, joints, |f| {
+        poses.sweep();
+        let start = Instant::now();
         crowd
             .frame(1.0 / 60.0, |i| CrowdPose {
                 transform: motion(f, i as f32 * a.phase_step),
-                locals: &rest,
+                locals: poses.of(i),
             })
-            .map_err(|e| e.to_string())
+            .map_err(|e| e.to_string())?;
+        Ok(start.elapsed().as_secs_f64())
     })
 }
 

@@ -562,6 +562,40 @@ fn bench_crowd_and_cloth() {
             "{bad:?}"
         );
     }
+    // `--cold`: the crowd path with a pose per character and the caches swept, said in
+    // the header; refused where it would time something else.
+    let out = tassel()
+        .args([
+            "bench", "--vrm", "spec", "--crowd", "20", "--cold", "--frames", "3", "--runs", "1",
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.lines().next().unwrap().contains("; cold: "),
+        "{stdout}"
+    );
+    assert!(stdout
+        .lines()
+        .last()
+        .unwrap()
+        .starts_with("crowd: 20 characters x 112 joints, 1 threads: "));
+    for bad in [
+        &["--crowd", "2", "--cold", "--compare"][..],
+        &["--crowd", "2", "--cold", "--cloth"][..],
+    ] {
+        let out = tassel().arg("bench").args(bad).output().unwrap();
+        assert!(!out.status.success(), "{bad:?}");
+        assert!(
+            String::from_utf8_lossy(&out.stderr).contains("--cold times the crowd path only"),
+            "{bad:?}"
+        );
+    }
 }
 
 #[test]
