@@ -257,11 +257,24 @@ fn vrm_crowd_is_the_same_on_one_and_two_threads() {
 
 /// Bad input names the character, which is held (its state as before); every other
 /// character, in its lane group too, steps exactly as in a crowd given only good input;
-/// the next good frame goes on.
+/// the next good frame goes on. In `spec` mode, and in `fixed` mode with 90 Hz steps, where
+/// the held character's last output was an output step's (frame 1 ends half a step after
+/// its step) and the frame it is held in ends on a step for everyone else (frame 2).
 #[test]
 fn vrm_crowd_rejects_bad_input_by_character() {
+    let fixed = VrmOptions {
+        mode: VrmMode::Fixed,
+        step_rate: 90.0,
+        ..Default::default()
+    };
+    for (options, held_at) in [(VrmOptions::spec(), 1), (fixed, 2)] {
+        held_by_character(options, held_at);
+    }
+}
+
+fn held_by_character(options: VrmOptions, held_at: usize) {
     let (sk, bones) = builtin::bench_vrm(4, 5, 2);
-    let rig = Arc::new(VrmRig::new(&sk, &bones, VrmOptions::spec()).unwrap());
+    let rig = Arc::new(VrmRig::new(&sk, &bones, options).unwrap());
     let sk = Arc::new(sk);
     let mut crowd = VrmCrowd::new(sk.clone(), rig.clone()).unwrap();
     for _ in 0..20 {
@@ -274,12 +287,14 @@ fn vrm_crowd_rejects_bad_input_by_character() {
         |f: usize, i: usize| Transform::from_translation(Vec3::X * (f as f32 * 0.05 + i as f32));
     // The same crowd given good input throughout: the reference for everyone but 17.
     let mut good = crowd.clone();
-    for c in [&mut crowd, &mut good] {
-        c.frame(1.0 / 60.0, |i| CrowdPose {
-            transform: at(0, i),
-            locals: &rest,
-        })
-        .unwrap();
+    for f in 0..held_at {
+        for c in [&mut crowd, &mut good] {
+            c.frame(1.0 / 60.0, |i| CrowdPose {
+                transform: at(f, i),
+                locals: &rest,
+            })
+            .unwrap();
+        }
     }
     let links = rig.links.len();
     let bits = |c: &VrmCrowd, i: usize| -> Vec<[u32; 4]> {
@@ -290,7 +305,7 @@ fn vrm_crowd_rejects_bad_input_by_character() {
     let before: Vec<_> = (0..20).map(|i| bits(&crowd, i)).collect();
     let err = crowd
         .frame(1.0 / 60.0, |i| CrowdPose {
-            transform: at(1, i),
+            transform: at(held_at, i),
             locals: if i == 17 { &bad } else { &rest },
         })
         .unwrap_err()
@@ -302,7 +317,7 @@ fn vrm_crowd_rejects_bad_input_by_character() {
     let held: Vec<usize> = crowd.held().map(|(i, _)| i).collect();
     assert_eq!(held, [17]);
     good.frame(1.0 / 60.0, |i| CrowdPose {
-        transform: at(1, i),
+        transform: at(held_at, i),
         locals: &rest,
     })
     .unwrap();
@@ -317,7 +332,7 @@ fn vrm_crowd_rejects_bad_input_by_character() {
     let short = &rest[..3];
     let err = crowd
         .frame(1.0 / 60.0, |i| CrowdPose {
-            transform: at(2, i),
+            transform: at(held_at + 1, i),
             locals: if i == 4 { short } else { &rest },
         })
         .unwrap_err();
@@ -330,7 +345,7 @@ fn vrm_crowd_rejects_bad_input_by_character() {
         .is_err());
     crowd
         .frame(1.0 / 60.0, |i| CrowdPose {
-            transform: at(3, i),
+            transform: at(held_at + 2, i),
             locals: &rest,
         })
         .unwrap();
