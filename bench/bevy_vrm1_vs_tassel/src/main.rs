@@ -20,7 +20,13 @@
 //! Timed: the spring step itself (between two marker systems around
 //! `TasselSystems::Step` and around `VrmSystemSets::SpringBone`), bevy_vrm1's step with
 //! the propagation it needs before it, and the whole `App::update`. Medians over rounds
-//! that alternate the apps, so that all see the same machine load.
+//! that alternate the apps, so that all see the same machine load: 25 rounds of 20 frames
+//! by default (each app's round a fraction of a second, so that a slow spell of the
+//! machine falls on every app; it was 5 rounds of 100 frames). The spread between runs
+//! stays (on 2026-12-02, one build, two compute threads, `fixed`: 4.63–6.38× at 5 × 100,
+//! 4.88–5.64× at 25 × 20): the crowd's solve waits on memory, whose speed moves more than
+//! bevy_vrm1's step does. The plugin's own clock (`STEP_TIME`) is printed beside the
+//! markers' time, with its parts.
 //!
 //! **`--avatar`: a real avatar with meshes.** Tassel's built-in character as a VRM 1.0 file
 //! (`tassel_gltf::builtin_avatar()`: 82 joints and a skinned body, 13 springs of 44 joints,
@@ -445,8 +451,8 @@ fn run(app: &mut App, frames: usize, out: &mut [Vec<f64>; 3]) {
 
 fn main() {
     let mut n = 1000usize;
-    let mut frames = 100usize;
-    let mut rounds = 5usize;
+    let mut frames = 20usize;
+    let mut rounds = 25usize;
     let mut threads = None;
     let mut colliders = true;
     let mut avatar = false;
@@ -637,7 +643,8 @@ fn main() {
                     .unwrap_or(f64::NAN)
             };
             println!(
-                "tassel-bevy `{name}` split: read {:.3} ms, solve {:.3} ms, write {:.3} ms",
+                "tassel-bevy `{name}` split: step {:.3} ms (its own clock) = read {:.3} ms, solve {:.3} ms, write {:.3} ms",
+                avg(&tassel_bevy::STEP_TIME),
                 avg(&tassel_bevy::READ_TIME),
                 avg(&tassel_bevy::SOLVE_TIME),
                 avg(&tassel_bevy::WRITE_TIME)
