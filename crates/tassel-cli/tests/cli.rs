@@ -474,30 +474,32 @@ fn inspect_lists_vrm_springs_and_clips() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("cut.glb"));
 }
 
-/// `--crowd N --threads T` ends with the line the crowd figures are read from; `--cloth`
-/// times the built-in skirt's 32 free points; bad counts and phase steps are refused.
-#[test]
-fn bench_crowd_and_cloth() {
-    let out = tassel()
-        .args([
-            "bench",
-            "--crowd",
-            "3",
-            "--threads",
-            "2",
-            "--frames",
-            "5",
-            "--runs",
-            "1",
-        ])
-        .output()
-        .unwrap();
+/// `tassel bench ARGS`, which must succeed: its standard output.
+fn bench_ok(args: &[&str]) -> String {
+    let out = tassel().arg("bench").args(args).output().unwrap();
     assert!(
         out.status.success(),
-        "{}",
+        "{args:?}: {}",
         String::from_utf8_lossy(&out.stderr)
     );
-    let stdout = String::from_utf8_lossy(&out.stdout);
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+/// `--crowd N --threads T` ends with the line the crowd figures are read from; `--cloth`
+/// times the built-in skirt's 32 free points; bad counts and phase steps are refused;
+/// `--cold` runs the crowd path and says so, and is refused where it would not.
+#[test]
+fn bench_crowd_and_cloth() {
+    let stdout = bench_ok(&[
+        "--crowd",
+        "3",
+        "--threads",
+        "2",
+        "--frames",
+        "5",
+        "--runs",
+        "1",
+    ]);
     // Chains go through the chain crowd path.
     assert!(
         stdout.lines().next().unwrap().contains("crowd path"),
@@ -512,27 +514,17 @@ fn bench_crowd_and_cloth() {
     );
     // So do VRM springs; --compare times the single-character path
     // in the same run and says the ratio before the last line.
-    let out = tassel()
-        .args([
-            "bench",
-            "--vrm",
-            "fixed",
-            "--crowd",
-            "9",
-            "--compare",
-            "--frames",
-            "5",
-            "--runs",
-            "1",
-        ])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let stdout = String::from_utf8_lossy(&out.stdout);
+    let stdout = bench_ok(&[
+        "--vrm",
+        "fixed",
+        "--crowd",
+        "9",
+        "--compare",
+        "--frames",
+        "5",
+        "--runs",
+        "1",
+    ]);
     let lines: Vec<&str> = stdout.lines().collect();
     assert!(lines[0].contains("crowd path"), "{stdout}");
     assert!(
@@ -564,18 +556,9 @@ fn bench_crowd_and_cloth() {
     }
     // `--cold`: the crowd path with a pose per character and the caches swept, said in
     // the header; refused where it would time something else.
-    let out = tassel()
-        .args([
-            "bench", "--vrm", "spec", "--crowd", "20", "--cold", "--frames", "3", "--runs", "1",
-        ])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let stdout = String::from_utf8_lossy(&out.stdout);
+    let stdout = bench_ok(&[
+        "--vrm", "spec", "--crowd", "20", "--cold", "--frames", "3", "--runs", "1",
+    ]);
     assert!(
         stdout.lines().next().unwrap().contains("; cold: "),
         "{stdout}"
