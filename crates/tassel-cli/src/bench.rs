@@ -424,8 +424,8 @@ struct Poses {
 }
 
 impl Poses {
-    /// Bytes `--cold` writes before every frame: twice the last-level cache of this
-    /// machine (32 MiB) and of most desktop processors.
+    /// Bytes `--cold` writes before every frame: twice this machine's last-level cache
+    /// (32 MiB; a processor with a larger one keeps part of the crowd in it).
     const SWEEP_BYTES: usize = 64 << 20;
     /// The most the per-character poses of `--cold` may take.
     const MAX_OWN_BYTES: usize = 2 << 30;
