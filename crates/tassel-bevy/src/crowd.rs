@@ -61,6 +61,10 @@ pub(crate) struct Kind {
     pub(crate) shared_bones: bool,
     /// Per member: how its bones are reached (tagged, or by entity).
     pub(crate) access: Vec<Access>,
+    /// Per member: whether the tagged read pass took a bone into its `locals` since the
+    /// last frame. A tagged member it did not is marked unchanged for the VRM crowd
+    /// ([`VrmCrowd::mark_pose_unchanged`]): its pose is not read again.
+    moved: Vec<bool>,
     /// Per member: its id in its bones' tags (stable while members move).
     uids: Vec<u32>,
     /// Id → member index (`u32::MAX`: a free id).
@@ -129,6 +133,7 @@ impl Kind {
                 bone_set: HashSet::new(),
                 shared_bones: false,
                 access: Vec::new(),
+                moved: Vec::new(),
                 uids: Vec::new(),
                 member_of: Vec::new(),
                 free_uids: Vec::new(),
@@ -182,6 +187,7 @@ impl Kind {
         self.member_of[uid as usize] = i as u32;
         self.uids.push(uid);
         self.access.push(Access::Entities);
+        self.moved.push(true);
         Some(i)
     }
 
@@ -237,6 +243,7 @@ impl Kind {
         self.spaces.swap_remove(i);
         self.held.swap_remove(i);
         self.access.swap_remove(i);
+        self.moved.swap_remove(i);
         let uid = self.uids.swap_remove(i);
         self.member_of[uid as usize] = u32::MAX;
         self.free_uids.push(uid);
@@ -273,6 +280,19 @@ impl Kind {
         };
         let pool = ComputeTaskPool::get();
         let parts = parts(pool);
+        if let Run::Vrm(c) = &mut self.run {
+            // A tagged member none of whose bones changed gives the crowd last frame's
+            // locals again (a member read by entity is read whole every frame).
+            for (m, (&a, &moved)) in self.access.iter().zip(&self.moved).enumerate() {
+                if a == Access::Tags && !moved {
+                    let _ = c.mark_pose_unchanged(m);
+                }
+            }
+        }
+        if dt.is_finite() && dt >= 0.0 {
+            // The frame runs (else the crowd forgets the marks, and the changes wait).
+            self.moved.fill(false);
+        }
         let result = match &mut self.run {
             Run::Vrm(c) => c.frame_parts(dt, input, parts, |jobs| {
                 pool.scope(|s| jobs.for_each(|job| s.spawn(async move { job.run() })));
@@ -334,6 +354,7 @@ impl Kind {
             member_of: &self.member_of,
             access: &self.access,
             locals: &mut self.locals,
+            moved: &mut self.moved,
         }
     }
 

@@ -10,7 +10,9 @@
 //! comparison with what the plugin wrote does); the write pass walks the written bones on
 //! one thread and sets each one's rotation from the crowd's output, gathered once per
 //! frame member after member. Both walk Bevy's tables in order, and the read touches
-//! nothing of a bone no animation moved.
+//! nothing of a bone no animation moved. A VRM member none of whose bones changed is
+//! marked unchanged for the crowd, which then reuses the pose its lane group kept instead
+//! of reading the member's input again (`VrmCrowd::mark_pose_unchanged`).
 //!
 //! The tags arrive with the commands applied after the step system, so a member reads and
 //! writes through its entities on the frame it joins (which also reads its whole pose,
@@ -64,6 +66,8 @@ pub(crate) struct ReadView<'k> {
     pub(crate) member_of: &'k [u32],
     pub(crate) access: &'k [Access],
     pub(crate) locals: &'k mut [Transform],
+    /// Per member: a bone was taken into its `locals` since the last frame.
+    pub(crate) moved: &'k mut [bool],
 }
 
 /// One kind's output as the tagged write pass copies it.
@@ -89,6 +93,7 @@ impl ReadView<'_> {
         let m = m as usize;
         if bone.reads && self.access.get(m) == Some(&Access::Tags) {
             self.locals[m * self.joints + bone.joint as usize] = to_tassel(t);
+            self.moved[m] = true;
         }
     }
 }

@@ -63,6 +63,13 @@ pub struct Args {
     /// crowd is about this slow). The crowd path only.
     #[arg(long, requires = "crowd")]
     cold: bool,
+    /// With --crowd, VRM springs: the characters' animated poses stay as they are (only
+    /// their transforms move, as in the Bevy bench without `--animated`), and the crowd is
+    /// told so before every frame (`VrmCrowd::mark_pose_unchanged`, as the Bevy plugin
+    /// marks the members no animation moved). The bench's poses never change; without
+    /// this flag the crowd reads them all the same.
+    #[arg(long, requires = "crowd")]
+    still: bool,
     /// Which code runs the solvers that have a lane path (VRM springs, twin chains, the
     /// cloth's contact tests; with --crowd, the crowd): `scalar` is the readable
     /// reference (the same bits, slower; one character only), `portable` lanes without
@@ -321,6 +328,13 @@ fn crowd(a: &Args, n: usize) -> Result<(), String> {
             "--cold times the crowd path only (VRM springs alone, or the bench chains)".into(),
         );
     }
+    if a.still && !(crowd_path && (file_crowd.is_some() || a.vrm.is_some())) {
+        return Err(
+            "--still marks a VRM crowd's poses unchanged: it needs --vrm or a file with \
+             VRM springs alone"
+                .into(),
+        );
+    }
     if crowd_path && a.simd == SimdBench::Scalar {
         return Err(
             "--simd scalar: the crowd path has only lanes (its scalar reference is one \
@@ -347,10 +361,15 @@ fn crowd(a: &Args, n: usize) -> Result<(), String> {
             joints,
             t,
             format!(
-                "crowd path, {}{}",
+                "crowd path, {}{}{}",
                 a.simd.describe(),
                 if a.cold {
                     "; cold: a pose buffer per character, 64 MiB written before every frame (not timed)"
+                } else {
+                    ""
+                },
+                if a.still {
+                    "; still: every pose marked unchanged"
                 } else {
                     ""
                 }
@@ -535,6 +554,11 @@ fn crowd_of(
     time_crowd(a, threads, frames, what, joints, |f| {
         poses.sweep();
         let start = Instant::now();
+        if a.still && f > 0 {
+            for i in 0..n {
+                crowd.mark_pose_unchanged(i).map_err(|e| e.to_string())?;
+            }
+        }
         crowd
             .frame(1.0 / 60.0, |i| CrowdPose {
                 transform: motion(f, i as f32 * a.phase_step),

@@ -487,7 +487,8 @@ fn bench_ok(args: &[&str]) -> String {
 
 /// `--crowd N --threads T` ends with the line the crowd figures are read from; `--cloth`
 /// times the built-in skirt's 32 free points; bad counts and phase steps are refused;
-/// `--cold` runs the crowd path and says so, and is refused where it would not.
+/// `--cold` runs the crowd path and says so, and is refused where it would not; so is
+/// `--still` outside a VRM crowd.
 #[test]
 fn bench_crowd_and_cloth() {
     let stdout = bench_ok(&[
@@ -579,6 +580,25 @@ fn bench_crowd_and_cloth() {
             "{bad:?}"
         );
     }
+    // `--still`: a VRM crowd told its poses do not change, said in the header; refused
+    // for the chains, which have no such mark.
+    let stdout = bench_ok(&[
+        "--vrm", "fixed", "--crowd", "20", "--still", "--frames", "3", "--runs", "1",
+    ]);
+    assert!(
+        stdout.lines().next().unwrap().contains("; still: "),
+        "{stdout}"
+    );
+    let out = tassel()
+        .args(["bench", "--crowd", "2", "--still"])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("--still marks a VRM crowd"),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
 }
 
 #[test]

@@ -113,6 +113,9 @@ impl VrmCrowd {
         pack.resets[lane] = 0;
         pack.accumulator[lane] = 0.0;
         pack.paths[lane] = CharacterPath::default();
+        // Its input is new: the group's kept pose is not it.
+        pack.unchanged[lane] = false;
+        pack.prev_is_input = false;
         self.len += 1;
         i
     }
@@ -129,6 +132,7 @@ impl VrmCrowd {
         let pack = &mut self.packs[last / LANES];
         pack.count -= 1;
         pack.needs_reset[last % LANES] = true;
+        pack.unchanged[last % LANES] = false;
         if pack.count == 0 {
             self.packs.pop();
         }
@@ -206,6 +210,23 @@ impl VrmCrowd {
         pack.needs_reset[i % LANES] = true;
         // As `VrmState::reset`: the path before is forgotten.
         pack.paths[i % LANES] = CharacterPath::default();
+        Ok(())
+    }
+
+    /// Promises that character `i`'s animated locals in the next frame's input are, bit
+    /// for bit, those of the last frame that ran (its world transform may change): a
+    /// character no clip moves, only carried. For the next frame only. In `fixed` mode
+    /// (the default), a lane group whose characters are all marked, and whose last frame
+    /// kept its input as it came (no character reset, held or moved into it), reuses
+    /// that kept pose instead of reading and checking every character's input again:
+    /// the same bits as without the mark, at less cost (the Bevy plugin marks the members
+    /// whose bones did not change). Elsewhere the mark changes nothing. A wrong mark
+    /// steps the group on last frame's pose, as if the caller had given it; the input's
+    /// length and transform are checked all the same. Mark after [`Self::swap`] and
+    /// [`Self::swap_remove`], which forget the marks of the characters they move.
+    pub fn mark_pose_unchanged(&mut self, i: usize) -> Result<()> {
+        self.check(i)?;
+        self.packs[i / LANES].unchanged[i % LANES] = true;
         Ok(())
     }
 
@@ -356,6 +377,10 @@ impl VrmCrowd {
     /// scratch): `None` for an empty crowd.
     fn prepare(&mut self, dt: f32, parts: usize) -> Result<Option<Frame<'_, Ctx<'_>>>> {
         if !(dt.is_finite() && dt >= 0.0) {
+            // No frame ran: the marks were for this one.
+            for pack in &mut self.packs {
+                pack.unchanged = [false; LANES];
+            }
             return Err(Error::InvalidTimeStep(dt));
         }
         if self.packs.is_empty() {

@@ -140,13 +140,34 @@ impl Ctx<'_> {
     {
         let sk = self.sk;
         let n = sk.len();
+        scratch.reused = false;
         if !self.rig.constraints.list.is_empty() {
             return self.gather_checked(pack, scratch, base, input);
+        }
+        let used = pack.count.min(LANES);
+        if self.rig.options.mode == VrmMode::Fixed
+            && pack.prev_is_input
+            && pack.unchanged[..used].iter().all(|&u| u)
+        {
+            // Every character's locals are last frame's, which the group kept as they
+            // came (checked then): only the transforms are read. One copy of the kept
+            // pose, in order, instead of a transposition of every character's input.
+            let mut component = Trs::splat(&Transform::IDENTITY);
+            for lane in 0..used {
+                let pose = input(base + lane);
+                if pose.locals.len() != n || !pose.transform.within_limits() {
+                    return self.gather_checked(pack, scratch, base, input);
+                }
+                component.set(lane, &pose.transform);
+            }
+            scratch.locals.copy_from_slice(&pack.prev_locals);
+            scratch.component = component;
+            scratch.reused = true;
+            return Ok(());
         }
         let rest: &[Transform] = sk.rest();
         let mut poses = [rest; LANES];
         let mut component = Trs::splat(&Transform::IDENTITY);
-        let used = pack.count.min(LANES);
         for (lane, slot) in poses.iter_mut().enumerate().take(used) {
             let pose = input(base + lane);
             if pose.locals.len() != n || !pose.transform.within_limits() {
@@ -400,6 +421,7 @@ impl Ctx<'_> {
         }
         pack.prev_component = comp;
         pack.needs_reset = [false; LANES];
+        pack.unchanged = [false; LANES];
     }
 
     /// One update of the lanes in `active` on `poses`, its colliders placed from them.
@@ -766,7 +788,14 @@ impl Ctx<'_> {
     #[inline(always)]
     fn keep_locals(&self, pack: &mut Pack, s: &mut Scratch, reset: M) {
         let plan = self.plan;
-        if reset.any() {
+        let reset_any = reset.any();
+        // A rig with node constraints keeps the constrained pose, not its input.
+        pack.prev_is_input = !reset_any && self.rig.constraints.list.is_empty();
+        if s.reused && !reset_any {
+            // The kept pose is this frame's already.
+            return;
+        }
+        if reset_any {
             for slot in 0..plan.joints.len() {
                 if let Some(i) = plan.link_at[slot] {
                     let kept = &mut s.locals[slot];

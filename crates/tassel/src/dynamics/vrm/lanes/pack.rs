@@ -180,6 +180,12 @@ pub(crate) struct Pack {
     /// Fixed mode: last frame's animated locals (per plan slot) and each character's
     /// recent transforms, and the time not yet stepped.
     pub(crate) prev_locals: Vec<Trs>,
+    /// Fixed mode: `prev_locals` holds last frame's input itself, every lane (no reset
+    /// wrote rest rotations into it, no character was held or moved in since).
+    pub(crate) prev_is_input: bool,
+    /// The characters whose caller promised this frame's animated locals are last
+    /// frame's ([`crate::crowd::VrmCrowd::mark_pose_unchanged`]); cleared by every frame.
+    pub(crate) unchanged: [bool; LANES],
     pub(crate) paths: Vec<CharacterPath>,
     pub(crate) accumulator: [f32; LANES],
     pub(crate) prev_component: Trs,
@@ -203,6 +209,8 @@ impl Pack {
             rotation: vec![id; links],
             out_rotation: vec![id; links],
             prev_locals: vec![Trs::splat(&Transform::IDENTITY); slots],
+            prev_is_input: false,
+            unchanged: [false; LANES],
             paths: vec![CharacterPath::default(); LANES],
             accumulator: [0.0; LANES],
             prev_component: Trs::splat(&Transform::IDENTITY),
@@ -270,6 +278,10 @@ impl Pack {
         for (d, t) in self.prev_locals.iter_mut().zip(&s.prev_locals) {
             d.set(l, t);
         }
+        // Another character's kept pose (or one put back after a held frame): the lane's
+        // input of last frame is not known to be it.
+        self.prev_is_input = false;
+        self.unchanged[l] = false;
         self.paths[l] = s.path;
         self.accumulator[l] = s.accumulator;
         self.prev_component.set(l, &s.prev_component);
@@ -294,6 +306,9 @@ pub(crate) struct Scratch {
     pub(crate) full_locals: Vec<Transform>,
     pub(crate) full_models: Vec<Transform>,
     pub(crate) component: Trs,
+    /// This group's `locals` are its kept pose, copied (its input was marked unchanged):
+    /// the pose need not be kept again.
+    pub(crate) reused: bool,
 }
 
 impl Scratch {
@@ -321,6 +336,7 @@ impl Scratch {
             full_locals: vec![Transform::IDENTITY; joints],
             full_models: vec![Transform::IDENTITY; joints],
             component: id,
+            reused: false,
         }
     }
 }
