@@ -346,6 +346,18 @@ int32_t tassel_crowd_remove(TasselCrowd *c,
 // `c` is NULL or a live crowd.
 size_t tassel_crowd_len(const TasselCrowd *c);
 
+// Promises that character `i`'s animated pose in the next frame's input is, bit for
+// bit, the last frame's (its transform may change): a character no animation moves,
+// only carried. For the next frame only. A VRM crowd in `fixed` mode then steps a lane
+// group of such characters on the pose it kept instead of reading their input again
+// (the same result, at less cost); elsewhere the mark changes nothing. A false mark
+// steps on last frame's pose. 0 = ok, -1 = error (no such character).
+//
+// # Safety
+// `c` is NULL or a live crowd.
+int32_t tassel_crowd_mark_pose_unchanged(TasselCrowd *c,
+                                         size_t i);
+
 // Character `i` starts again from its pose on the next frame (a cut, a respawn, a
 // teleport). 0 = ok, -1 = error.
 //

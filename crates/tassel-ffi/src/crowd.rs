@@ -203,6 +203,16 @@ impl FlatCrowd {
         Ok(())
     }
 
+    /// See `tassel_crowd_mark_pose_unchanged`.
+    pub fn mark_pose_unchanged(&mut self, i: usize) -> Result<(), String> {
+        self.check(i)?;
+        match &mut self.run {
+            Run::Vrm(c) => c.mark_pose_unchanged(i).map_err(|e| e.to_string()),
+            // Nothing to reuse: the mark changes nothing.
+            Run::Chains(_) | Run::Characters(_) => Ok(()),
+        }
+    }
+
     /// Character `i` starts again from its pose on the next frame (a cut, a respawn).
     pub fn reset(&mut self, i: usize) -> Result<(), String> {
         self.check(i)?;

@@ -33,7 +33,8 @@ fn builtin(keep: &[&str]) -> (Vec<u8>, String) {
 
 /// Character `i`'s input at frame `f`: its root (swaying, each character its own phase;
 /// a jump at frame 40 for character 1) and every joint's animated local (the rest pose,
-/// the first read joints turned a little).
+/// the first read joints turned a little, the turn changing every eighth frame: the
+/// frames between repeat the pose, and the crowd is told so).
 fn input(kind: &FlatCharacter, read: &[usize], i: usize, f: usize) -> ([f32; F], Vec<f32>) {
     let t = f as f32 / 60.0;
     let phase = i as f32 * 0.7;
@@ -54,8 +55,9 @@ fn input(kind: &FlatCharacter, read: &[usize], i: usize, f: usize) -> ([f32; F],
     let mut locals = vec![0.0; kind.joint_count() * F];
     kind.rest_locals(&mut locals).unwrap();
     // Turn the first two read joints (a hips and a head, say) about x.
+    let held = (f / 8 * 8) as f32 / 60.0;
     for (k, &j) in read.iter().take(2).enumerate() {
-        common::turn_about_x(&mut locals, j, 0.3 * (4.0 * t + phase + k as f32).sin());
+        common::turn_about_x(&mut locals, j, 0.3 * (4.0 * held + phase + k as f32).sin());
     }
     (root, locals)
 }
@@ -72,7 +74,9 @@ fn dt(f: usize) -> f32 {
 /// Runs `count` characters of `bytes` + `rig` in `mode` through a crowd and through one
 /// flat character each, 80 frames, and checks the written joints bit for bit. Character 2
 /// is reset at frame 50; at frame 60 character 0 is removed (the last takes its place);
-/// at frame 35 character 3 gets a NaN (held: not stepped, out not written).
+/// at frame 35 character 3 gets a NaN (held: not stepped, out not written). A member whose
+/// read joints have the bits of its last frame's is marked unchanged
+/// (`mark_pose_unchanged`, as a caller that knows its clip did not move would).
 fn crowd_matches_characters(bytes: &[u8], rig: Option<&str>, mode: Option<&str>, want_kind: &str) {
     let kind = FlatCharacter::load(bytes, rig, mode).unwrap();
     let mut crowd = FlatCrowd::new(&kind);
@@ -93,6 +97,9 @@ fn crowd_matches_characters(bytes: &[u8], rig: Option<&str>, mode: Option<&str>,
     let read = crowd.read_joints().to_vec();
     let written = crowd.written_joints().to_vec();
     let mut out = vec![f32::NAN; count * written.len() * F];
+    // Each member's (by id) read joints' bits in the last frame.
+    let mut last: Vec<Option<Vec<u32>>> = vec![None; count];
+    let mut marks = 0;
     for f in 0..80 {
         if f == 50 {
             crowd.reset(2).unwrap();
@@ -112,9 +119,16 @@ fn crowd_matches_characters(bytes: &[u8], rig: Option<&str>, mode: Option<&str>,
                 l[read[read.len() - 1] * F + 3] = f32::NAN;
             }
             roots.extend_from_slice(&root);
+            let start = locals.len();
             for &j in &read {
                 locals.extend_from_slice(&l[j * F..(j + 1) * F]);
             }
+            let bits: Vec<u32> = locals[start..].iter().map(|x| x.to_bits()).collect();
+            if last[*id].as_ref() == Some(&bits) {
+                crowd.mark_pose_unchanged(full.len()).unwrap();
+                marks += 1;
+            }
+            last[*id] = Some(bits);
             full.push((root, l));
         }
         let before = out.clone();
@@ -153,6 +167,8 @@ fn crowd_matches_characters(bytes: &[u8], rig: Option<&str>, mode: Option<&str>,
             }
         }
     }
+    assert!(marks > 200, "{marks} marks");
+    assert!(crowd.mark_pose_unchanged(crowd.len()).is_err());
 }
 
 #[test]

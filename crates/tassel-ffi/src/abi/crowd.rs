@@ -99,6 +99,23 @@ pub unsafe extern "C" fn tassel_crowd_len(c: *const TasselCrowd) -> usize {
     })
 }
 
+/// Promises that character `i`'s animated pose in the next frame's input is, bit for
+/// bit, the last frame's (its transform may change): a character no animation moves,
+/// only carried. For the next frame only. A VRM crowd in `fixed` mode then steps a lane
+/// group of such characters on the pose it kept instead of reading their input again
+/// (the same result, at less cost); elsewhere the mark changes nothing. A false mark
+/// steps on last frame's pose. 0 = ok, -1 = error (no such character).
+///
+/// # Safety
+/// `c` is NULL or a live crowd.
+#[no_mangle]
+pub unsafe extern "C" fn tassel_crowd_mark_pose_unchanged(c: *mut TasselCrowd, i: usize) -> i32 {
+    guard("tassel_crowd_mark_pose_unchanged", -1, || {
+        // SAFETY: the caller's promise.
+        unsafe { crowd_mut(c) }?.mark_pose_unchanged(i).map(|_| 0)
+    })
+}
+
 /// Character `i` starts again from its pose on the next frame (a cut, a respawn, a
 /// teleport). 0 = ok, -1 = error.
 ///
