@@ -123,6 +123,32 @@ impl Ctx<'_> {
         self.step_lanes::<Fz>(pack, s)
     }
 
+    /// Asks the caches for the animated poses `pack`'s next gather reads (group `base`),
+    /// unless it will reuse its kept pose ([`crate::crowd::VrmCrowd::mark_pose_unchanged`]).
+    /// A hint only: changes no value.
+    pub(crate) fn prefetch_input<'a, I>(&self, pack: &Pack, base: usize, input: &I)
+    where
+        I: Fn(usize) -> CrowdPose<'a> + Sync,
+    {
+        let used = pack.count.min(LANES);
+        if self.reuses(pack) {
+            return;
+        }
+        for lane in 0..used {
+            crate::lanes::prefetch(input(base + lane).locals);
+        }
+    }
+
+    /// Whether `pack`'s gather will take its kept pose instead of its input: `fixed` mode,
+    /// the pose kept as it came, every character marked unchanged.
+    fn reuses(&self, pack: &Pack) -> bool {
+        let used = pack.count.min(LANES);
+        self.rig.options.mode == VrmMode::Fixed
+            && self.rig.constraints.list.is_empty()
+            && pack.prev_is_input
+            && pack.unchanged[..used].iter().all(|&u| u)
+    }
+
     /// [`Ctx::gather_checked`]'s result, faster where the input is good and no
     /// constraint applies: the poses are transposed into lanes first and checked there,
     /// eight characters per operation. Any failed check (or constraints) runs
@@ -145,10 +171,7 @@ impl Ctx<'_> {
             return self.gather_checked(pack, scratch, base, input);
         }
         let used = pack.count.min(LANES);
-        if self.rig.options.mode == VrmMode::Fixed
-            && pack.prev_is_input
-            && pack.unchanged[..used].iter().all(|&u| u)
-        {
+        if self.reuses(pack) {
             // Every character's locals are last frame's, which the group kept as they
             // came (checked then): only the transforms are read. One copy of the kept
             // pose, in order, instead of a transposition of every character's input.
