@@ -338,8 +338,10 @@ impl VrmCrowd {
 
     /// Advances every character by `dt` seconds (finite, ≥ 0; the first frame of a
     /// character only takes its pose, whatever `dt`). `input(i)` gives character `i`'s
-    /// world transform and animated pose; it is called once per character, from the
-    /// rayon pool's threads.
+    /// world transform and animated pose; it is called from the rayon pool's threads, at
+    /// least once per character and sometimes more (a lane group's input is asked for
+    /// ahead of its step, to prefetch it; a group with a bad input is gathered again), so
+    /// keep it cheap and free of side effects.
     ///
     /// A character whose input is bad (wrong length, not finite, beyond the limits) is
     /// held: not stepped this frame (its state and results stay as they were, as a
