@@ -485,6 +485,14 @@ fn bench_ok(args: &[&str]) -> String {
     String::from_utf8_lossy(&out.stdout).into_owned()
 }
 
+/// `tassel bench ARGS` must fail, saying `says` on its standard error.
+fn bench_refused(args: &[&str], says: &str) {
+    let out = tassel().arg("bench").args(args).output().unwrap();
+    assert!(!out.status.success(), "{args:?}");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains(says), "{args:?}: {stderr}");
+}
+
 /// `--crowd N --threads T` ends with the line the crowd figures are read from; `--cloth`
 /// times the built-in skirt's 32 free points; bad counts and phase steps are refused;
 /// `--cold` runs the crowd path and says so, and is refused where it would not; so is
@@ -548,12 +556,7 @@ fn bench_crowd_and_cloth() {
         &["--crowd", "2", "--phase-step", "nan"][..],
         &["--crowd", "2", "--phase-step", "1e9"][..],
     ] {
-        let out = tassel().arg("bench").args(bad).output().unwrap();
-        assert!(!out.status.success(), "{bad:?}");
-        assert!(
-            String::from_utf8_lossy(&out.stderr).contains("must be"),
-            "{bad:?}"
-        );
+        bench_refused(bad, "must be");
     }
     // `--cold`: the crowd path with a pose per character and the caches swept, said in
     // the header; refused where it would time something else.
@@ -573,12 +576,7 @@ fn bench_crowd_and_cloth() {
         &["--crowd", "2", "--cold", "--compare"][..],
         &["--crowd", "2", "--cold", "--cloth"][..],
     ] {
-        let out = tassel().arg("bench").args(bad).output().unwrap();
-        assert!(!out.status.success(), "{bad:?}");
-        assert!(
-            String::from_utf8_lossy(&out.stderr).contains("--cold times the crowd path only"),
-            "{bad:?}"
-        );
+        bench_refused(bad, "--cold times the crowd path only");
     }
     // `--still`: a VRM crowd told its poses do not change, said in the header; refused
     // for the chains, which have no such mark.
@@ -589,16 +587,7 @@ fn bench_crowd_and_cloth() {
         stdout.lines().next().unwrap().contains("; still: "),
         "{stdout}"
     );
-    let out = tassel()
-        .args(["bench", "--crowd", "2", "--still"])
-        .output()
-        .unwrap();
-    assert!(!out.status.success());
-    assert!(
-        String::from_utf8_lossy(&out.stderr).contains("--still marks a VRM crowd"),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    bench_refused(&["--crowd", "2", "--still"], "--still marks a VRM crowd");
 }
 
 #[test]

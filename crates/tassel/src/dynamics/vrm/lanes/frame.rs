@@ -130,11 +130,10 @@ impl Ctx<'_> {
     where
         I: Fn(usize) -> CrowdPose<'a> + Sync,
     {
-        let used = pack.count.min(LANES);
         if self.reuses(pack) {
             return;
         }
-        for lane in 0..used {
+        for lane in 0..pack.count.min(LANES) {
             crate::lanes::prefetch(input(base + lane).locals);
         }
     }
